@@ -1,0 +1,85 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/class_cluster.hpp"
+#include "act_color/core/color_lut.hpp"
+#include "act_color/core/expected_class_model.hpp"
+#include "act_color/core/image_view.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+
+// Parameters of ACT; defaults are the paper's. validate() throws std::invalid_argument naming
+// the parameter and its allowed range.
+struct ActParams {
+  double eta = 4.0;         // eq. 4, 5
+  double zeta = 2.5;        // add c -> k when |mu_k - c| < zeta * sigma_k (2.3)
+  double xi = 1.35;         // remove c from k when |mu_k - c| > xi * sigma_k (2.4)
+  double sigma_min = 6.0;   // lower bound of sigma_k, channel units (2.2)
+  int cluster_stride = 400; // every n-th pixel updates the clusters (2.2)
+  int add_stride = 400;     // every n-th pixel is added (2.3)
+  int remove_stride = 20;   // every n-th pixel off the field is removed (2.4)
+  int lut_bits = 6;         // bits per channel of the table
+  bool white_filter = true; // eq. 1
+  uint32_t seed = 1;        // random start pixels
+
+  void validate() const;
+};
+
+// What one cycle did.
+struct CycleStats {
+  std::array<uint32_t, kNumClasses> cluster_samples{};  // colors that updated each cluster
+  std::array<uint32_t, kNumClasses> added{};            // table cells set to each class
+  std::array<uint32_t, kNumClasses> removed{};          // cells of each class cleared
+  uint32_t remove_candidates = 0;                       // off-field pixels examined
+  uint32_t doublings = 0;                               // sigma doublings over all clusters
+  bool color_space_changed = false;                     // table reset for a new color space
+};
+
+// The ACT algorithm (paper, section 2): one cycle per image and pose.
+class ActTrainer {
+ public:
+  explicit ActTrainer(const Calibration& calibration, const ActParams& params = ActParams());
+
+  // Throws std::invalid_argument when the image does not fit the calibration.
+  void checkImage(const ImageView& image) const;
+
+  // One training cycle: cluster update (2.2), additions (2.3), removals (2.4).
+  CycleStats cycle(const ImageView& image, const Pose2D& pose);
+  // The start-up table: `cycles` cycles on one image at a known pose (paper, section 2).
+  void bootstrap(const ImageView& image, const Pose2D& pose, int cycles);
+
+  // New parameters keep the table and clusters unless lut_bits changes.
+  void setParams(const ActParams& params);
+  const ActParams& params() const { return params_; }
+  // Empty table, clusters at eq. 2-3.
+  void reset(ColorSpace space);
+  // Installs a saved table (e.g. from a file); throws std::invalid_argument if sizes differ.
+  void loadTable(const ColorLut& lut);
+
+  const ColorLut& lut() const { return lut_; }
+  const std::array<ClassCluster, kNumClasses>& clusters() const { return clusters_; }
+  uint64_t revision() const { return revision_; }
+  const ExpectedClassModel& model() const { return model_; }
+
+ private:
+  ClusterParams clusterParams() const;
+
+  ExpectedClassModel model_;
+  ActParams params_;
+  ColorLut lut_;
+  std::array<ClassCluster, kNumClasses> clusters_;
+  std::mt19937 rng_;
+  uint64_t revision_ = 0;
+  bool space_known_ = false;
+  // Per-cycle scratch, kept to avoid allocations.
+  std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
+};
+
+}  // namespace act_color

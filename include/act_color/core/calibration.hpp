@@ -1,0 +1,67 @@
+#pragma once
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace act_color {
+
+// The camera-to-world mapping of the contract's calibration file.
+struct CameraCalibration {
+  int width = 0;
+  int height = 0;
+  double center_u = 0.0;
+  double center_v = 0.0;
+  int bearing_sign = 1;
+  double bearing_offset_rad = 0.0;
+  double height_m = 0.0;
+  double chassis_radius_px = 0.0;
+  double mirror_radius_px = 0.0;
+  // (r_px, elevation_rad), both strictly increasing.
+  std::vector<std::pair<double, double>> elevation_map;
+};
+
+// 2007-rules MSL field geometry. Lengths to the outer edges of lines.
+struct FieldCalibration {
+  double length_m = 0.0;
+  double width_m = 0.0;
+  double line_width_m = 0.0;
+  double margin_m = 0.0;
+  double center_circle_radius_m = 0.0;
+  double corner_arc_radius_m = 0.0;
+  double goal_area_depth_m = 0.0;
+  double goal_area_width_m = 0.0;
+  double penalty_area_depth_m = 0.0;
+  double penalty_area_width_m = 0.0;
+  std::optional<double> penalty_mark_distance_m;
+  double goal_width_m = 0.0;
+  double goal_height_m = 0.0;
+  double goal_depth_m = 0.0;
+  int yellow_goal_x_sign = 1;
+};
+
+struct Calibration {
+  CameraCalibration camera;
+  FieldCalibration field;
+};
+
+// Thrown for a calibration that cannot be read or breaks a rule; the message names the file and
+// the offending key (e.g. "cal.yaml: camera.elevation_map: r must increase strictly ...").
+class CalibrationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Reads and validates a calibration file. Unknown keys, missing keys, wrong types and values out
+// of range are errors.
+Calibration loadCalibration(const std::string& path);
+// The same from YAML text; `source_name` is used in error messages.
+Calibration parseCalibration(const std::string& yaml_text, const std::string& source_name);
+// Checks ranges and consistency of an already filled calibration; throws CalibrationError.
+void validateCalibration(const Calibration& calibration, const std::string& source_name);
+// YAML text in the contract's format; parseCalibration(toYaml(c)) == c.
+std::string toYaml(const Calibration& calibration);
+
+}  // namespace act_color

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "act_color/core/image_view.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+
+// Color look-up table: one class id per cell of a color space quantised to `bits` per channel.
+class ColorLut {
+ public:
+  explicit ColorLut(int bits_per_channel = 6, ColorSpace space = ColorSpace::kRgb);
+
+  int bitsPerChannel() const { return bits_; }
+  ColorSpace colorSpace() const { return space_; }
+  size_t size() const { return table_.size(); }
+
+  uint32_t index(uint8_t c0, uint8_t c1, uint8_t c2) const {
+    return (static_cast<uint32_t>(c0 >> shift_) << (2 * bits_)) | (static_cast<uint32_t>(c1 >> shift_) << bits_) |
+           static_cast<uint32_t>(c2 >> shift_);
+  }
+  uint8_t classOf(uint8_t c0, uint8_t c1, uint8_t c2) const { return table_[index(c0, c1, c2)]; }
+  uint8_t at(uint32_t cell) const { return table_[cell]; }
+  void set(uint32_t cell, uint8_t class_id) { table_[cell] = class_id; }
+  void clear();
+
+  // Cells per class id.
+  std::array<uint32_t, kNumClasses> cellCounts() const;
+
+  const std::vector<uint8_t>& table() const { return table_; }
+  // Replaces the table; `table.size()` must equal size().
+  void assign(const std::vector<uint8_t>& table);
+  const uint8_t* data() const { return table_.data(); }
+
+ private:
+  int bits_;
+  int shift_;
+  ColorSpace space_;
+  std::vector<uint8_t> table_;
+};
+
+}  // namespace act_color

@@ -1,0 +1,64 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/field_model.hpp"
+#include "act_color/core/image_view.hpp"
+#include "act_color/core/omni_camera_model.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+
+// Expected-label value of a pixel the field model puts on a line but that fails eq. 1.
+constexpr uint8_t kRejectedWhite = 254;
+
+// A pose ready for transforming many points: base_link -> field.
+struct PoseTransform {
+  explicit PoseTransform(const Pose2D& pose)
+      : x_m(pose.x_m), y_m(pose.y_m), cos_theta(std::cos(pose.theta_rad)), sin_theta(std::sin(pose.theta_rad)) {}
+  double x_m, y_m, cos_theta, sin_theta;
+  void apply(double bx, double by, double* fx, double* fy) const {
+    *fx = x_m + cos_theta * bx - sin_theta * by;
+    *fy = y_m + sin_theta * bx + cos_theta * by;
+  }
+};
+
+// The expected class of a pixel given the robot's pose (paper, section 2.1).
+class ExpectedClassModel {
+ public:
+  explicit ExpectedClassModel(const Calibration& calibration);
+
+  const FieldModel& field() const { return field_; }
+  const OmniCameraModel& camera() const { return camera_; }
+
+  // Class from geometry alone: kNotImaged outside the mirror, kBlack on the own chassis, kYellow
+  // or kBlue where the ray meets a goal, kWhite or kGreen where it meets the carpet (white before
+  // eq. 1), kUnknown elsewhere (off the carpet, above the horizon).
+  uint8_t geometricClass(size_t pixel_index, const PoseTransform& pose) const;
+
+  // True when the floor point of pixel `pixel_index` is surely on the carpet and not in a goal
+  // region: used to skip pixels that cannot be unknown. `safe_range_m` from safeCarpetRange().
+  bool surelyOnCarpet(size_t pixel_index, double safe_range_m) const {
+    return ground_range_m_[pixel_index] < safe_range_m;
+  }
+  // Distance from the robot to the nearest carpet edge or goal box (0 when outside the carpet).
+  double safeCarpetRange(const Pose2D& pose) const;
+
+  // eq. 1: the pixel is brighter than the mean of its 5x5 neighbourhood. False within 2 px of
+  // the image border.
+  static bool brighterThanNeighbourhood(const ImageView& image, int u, int v);
+
+  // Expected class of every pixel with eq. 1 applied to white (pixels failing it become
+  // kRejectedWhite: they train nothing); kNotImaged outside the mirror. For inspection and tests.
+  cv::Mat expectedLabels(const ImageView& image, const Pose2D& pose) const;
+
+ private:
+  FieldModel field_;
+  OmniCameraModel camera_;
+  // Ground distance of each floor pixel's floor point; +inf for others.
+  std::vector<float> ground_range_m_;
+};
+
+}  // namespace act_color

@@ -1,0 +1,48 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+
+// The static world of a 2007-rules MSL field in the `field` frame: carpet, lines and marks, the
+// green margin and the two goals as solid colored boxes behind the goal lines.
+class FieldModel {
+ public:
+  explicit FieldModel(const FieldCalibration& field);
+
+  const FieldCalibration& calibration() const { return field_; }
+
+  // Class of the floor at (x, y): kWhite on a line or mark, kGreen on carpet or margin,
+  // kUnknown beyond the margin. Goals are not part of the floor (see goalHit).
+  ColorClass floorClass(double x_m, double y_m) const;
+  bool isLine(double x_m, double y_m) const;
+  // Inside the carpet (playable field plus margin).
+  bool onCarpet(double x_m, double y_m) const {
+    return std::abs(x_m) <= carpet_half_length_m_ && std::abs(y_m) <= carpet_half_width_m_;
+  }
+
+  // First goal box met by the ray origin + t * dir (t > 0) before parameter `t_max`:
+  // kYellow or kBlue, kUnknown when none. `t_hit` receives the entry parameter.
+  ColorClass goalHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                     double* t_hit = nullptr) const;
+
+  // Goal box of the given color: min and max corners in the field frame.
+  void goalBox(ColorClass goal, Eigen::Vector3d* min_corner, Eigen::Vector3d* max_corner) const;
+
+  double halfLength() const { return half_length_m_; }
+  double halfWidth() const { return half_width_m_; }
+
+ private:
+  FieldCalibration field_;
+  double half_length_m_;
+  double half_width_m_;
+  double carpet_half_length_m_;
+  double carpet_half_width_m_;
+  Eigen::Vector3d goal_min_[2];  // [0] yellow, [1] blue
+  Eigen::Vector3d goal_max_[2];
+};
+
+}  // namespace act_color

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <string>
+
+namespace act_color {
+
+// Pixel layouts the package accepts (ROS encodings rgb8, bgr8, yuv422 = UYVY).
+enum class PixelFormat : uint8_t { kRgb8 = 0, kBgr8 = 1, kUyvy = 2 };
+
+// Color space of look-up tables and clusters: the camera's own, so that classification needs no
+// conversion: RGB for rgb8/bgr8 images, YUV for yuv422.
+enum class ColorSpace : uint8_t { kRgb = 0, kYuv = 1 };
+
+ColorSpace nativeColorSpace(PixelFormat format);
+// Parses a ROS encoding string; false for anything unsupported.
+bool pixelFormatFromEncoding(const std::string& encoding, PixelFormat* format);
+const char* encodingName(PixelFormat format);
+
+// A non-owning view of an image in one of the supported layouts.
+struct ImageView {
+  const uint8_t* data = nullptr;
+  int width = 0;
+  int height = 0;
+  size_t step = 0;  // bytes per row
+  PixelFormat format = PixelFormat::kRgb8;
+
+  ImageView() = default;
+  ImageView(const uint8_t* d, int w, int h, size_t s, PixelFormat f) : data(d), width(w), height(h), step(s), format(f) {}
+  // rgb8/bgr8: CV_8UC3; UYVY: CV_8UC2 (OpenCV's layout for YUV 4:2:2).
+  static ImageView fromMat(const cv::Mat& mat, PixelFormat format);
+
+  // Color of pixel (u, v) in the native color space: (R, G, B) or (Y, U, V).
+  void color(int u, int v, uint8_t out[3]) const {
+    const uint8_t* row = data + static_cast<size_t>(v) * step;
+    if (format == PixelFormat::kUyvy) {
+      const uint8_t* p = row + 4 * (u >> 1);
+      out[0] = p[(u & 1) ? 3 : 1];
+      out[1] = p[0];
+      out[2] = p[2];
+      return;
+    }
+    const uint8_t* p = row + 3 * u;
+    const bool bgr = format == PixelFormat::kBgr8;
+    out[0] = p[bgr ? 2 : 0];
+    out[1] = p[1];
+    out[2] = p[bgr ? 0 : 2];
+  }
+
+  // Intensity used by the white filter (eq. 1): R+G+B, or 3*Y, so both spaces compare alike.
+  int intensity(int u, int v) const {
+    const uint8_t* row = data + static_cast<size_t>(v) * step;
+    switch (format) {
+      case PixelFormat::kRgb8:
+      case PixelFormat::kBgr8: {
+        const uint8_t* p = row + 3 * u;
+        return p[0] + p[1] + p[2];
+      }
+      case PixelFormat::kUyvy:
+        return 3 * row[4 * (u >> 1) + ((u & 1) ? 3 : 1)];
+    }
+    return 0;
+  }
+};
+
+// Converts an rgb8 image (CV_8UC3) to UYVY (CV_8UC2), BT.601 full range; for tests and the
+// simulator's yuv422 output.
+cv::Mat rgbToUyvy(const cv::Mat& rgb);
+
+}  // namespace act_color

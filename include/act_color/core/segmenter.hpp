@@ -1,0 +1,35 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/color_lut.hpp"
+#include "act_color/core/image_view.hpp"
+
+namespace act_color {
+
+// Classifies whole images with a look-up table.
+class Segmenter {
+ public:
+  // Without a camera: every pixel is classified.
+  Segmenter() = default;
+  // With a camera: only pixels inside the mirror are classified, the rest are kUnknown.
+  explicit Segmenter(const CameraCalibration& camera);
+
+  // labels: CV_8UC1 of the image's size, reallocated only when its size differs. Throws
+  // std::invalid_argument when the table's color space does not fit the image's format or the
+  // image size does not fit the camera.
+  void classify(const ColorLut& lut, const ImageView& image, cv::Mat& labels) const;
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  // Per row, the half-open column span inside the mirror; empty when no camera was given.
+  std::vector<std::pair<int, int>> spans_;
+};
+
+// Class ids to the rgb8 palette of classPalette(); 255 (not imaged) becomes dark grey.
+void colorizeLabels(const cv::Mat& labels, cv::Mat& rgb);
+
+}  // namespace act_color

@@ -1,0 +1,38 @@
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+namespace act_color {
+
+// Class ids of the contract (README, "Color classes"). Label images hold these values.
+enum ColorClass : uint8_t {
+  kUnknown = 0,
+  kGreen = 1,
+  kWhite = 2,
+  kYellow = 3,
+  kBlue = 4,
+  kBlack = 5,
+  kOrange = 6,
+};
+constexpr int kNumClasses = 7;
+// Truth label value for pixels outside the mirror; evaluators skip it.
+constexpr uint8_t kNotImaged = 255;
+
+const char* className(int class_id);
+
+// Palette used for classified images (rgb8), index = class id.
+const std::array<std::array<uint8_t, 3>, kNumClasses>& classPalette();
+
+// Pose of base_link in the field frame.
+struct Pose2D {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double theta_rad = 0.0;
+
+  bool isFinite() const { return std::isfinite(x_m) && std::isfinite(y_m) && std::isfinite(theta_rad); }
+};
+
+}  // namespace act_color

@@ -1,0 +1,170 @@
+#include "act_color/core/act_trainer.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace act_color {
+namespace {
+
+void requireRange(const char* name, double value, double lo, double hi, bool lo_open = false) {
+  const bool below = lo_open ? !(value > lo) : !(value >= lo);
+  if (below || !(value <= hi)) {
+    std::ostringstream s;
+    s << "parameter " << name << " must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], is " << value;
+    throw std::invalid_argument(s.str());
+  }
+}
+
+}  // namespace
+
+void ActParams::validate() const {
+  requireRange("eta", eta, 0.0, 1000.0);
+  requireRange("zeta", zeta, 0.0, 100.0, true);
+  requireRange("xi", xi, 0.0, 100.0, true);
+  requireRange("sigma_min", sigma_min, 0.0, 255.0);
+  requireRange("cluster_stride", cluster_stride, 1, 1 << 20);
+  requireRange("add_stride", add_stride, 1, 1 << 20);
+  requireRange("remove_stride", remove_stride, 1, 1 << 20);
+  requireRange("lut_bits", lut_bits, 1, 8);
+}
+
+ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
+    : model_(calibration), params_(params), lut_(params.lut_bits), rng_(params.seed) {
+  params_.validate();
+  reset(ColorSpace::kRgb);
+  space_known_ = false;
+}
+
+void ActTrainer::reset(ColorSpace space) {
+  lut_ = ColorLut(params_.lut_bits, space);
+  for (auto& cluster : clusters_) cluster.reset(255.0);
+  space_known_ = true;
+}
+
+void ActTrainer::setParams(const ActParams& params) {
+  params.validate();
+  const bool bits_changed = params.lut_bits != params_.lut_bits;
+  const bool seed_changed = params.seed != params_.seed;
+  params_ = params;
+  if (seed_changed) rng_.seed(params_.seed);
+  if (bits_changed) {
+    const bool known = space_known_;
+    reset(lut_.colorSpace());
+    space_known_ = known;
+  }
+}
+
+void ActTrainer::loadTable(const ColorLut& lut) {
+  if (lut.bitsPerChannel() != params_.lut_bits) {
+    throw std::invalid_argument("table has " + std::to_string(lut.bitsPerChannel()) + " bits per channel, lut_bits is " +
+                                std::to_string(params_.lut_bits));
+  }
+  lut_ = lut;
+  space_known_ = true;
+}
+
+ClusterParams ActTrainer::clusterParams() const {
+  ClusterParams p;
+  p.eta = params_.eta;
+  p.sigma_min = params_.sigma_min;
+  p.zeta = params_.zeta;
+  return p;
+}
+
+void ActTrainer::checkImage(const ImageView& image) const {
+  const auto& camera = model_.camera();
+  if (image.data == nullptr) throw std::invalid_argument("empty image");
+  if (image.width != camera.width() || image.height != camera.height()) {
+    std::ostringstream s;
+    s << "image is " << image.width << "x" << image.height << " px, the calibration is for " << camera.width() << "x"
+      << camera.height();
+    throw std::invalid_argument(s.str());
+  }
+  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
+  if (image.step < bytes_per_pixel * image.width) throw std::invalid_argument("image row step is too small");
+  if (image.format == PixelFormat::kUyvy && image.width % 2 != 0) throw std::invalid_argument("yuv422 needs an even width");
+}
+
+CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
+  checkImage(image);
+  if (!pose.isFinite()) throw std::invalid_argument("pose is not finite");
+  CycleStats stats;
+  const ColorSpace space = nativeColorSpace(image.format);
+  if (!space_known_ || space != lut_.colorSpace()) {
+    stats.color_space_changed = space_known_;
+    reset(space);
+  }
+
+  const PoseTransform transform(pose);
+  const int width = image.width;
+  const size_t pixels = static_cast<size_t>(width) * image.height;
+  auto randomStart = [this](int stride) { return std::uniform_int_distribution<int>(0, stride - 1)(rng_); };
+  // Expected class with eq. 1 for white; kNotImaged for pixels that train nothing.
+  auto expected = [&](size_t i) -> uint8_t {
+    const uint8_t c = model_.geometricClass(i, transform);
+    if (c == kWhite && params_.white_filter &&
+        !ExpectedClassModel::brighterThanNeighbourhood(image, static_cast<int>(i % width), static_cast<int>(i / width))) {
+      return kNotImaged;
+    }
+    return c;
+  };
+  auto colorAt = [&](size_t i, uint8_t out[3]) { image.color(static_cast<int>(i % width), static_cast<int>(i / width), out); };
+
+  // 2.2: cluster update from every n-th pixel.
+  for (auto& s : samples_) s.clear();
+  for (size_t i = randomStart(params_.cluster_stride); i < pixels; i += params_.cluster_stride) {
+    const uint8_t k = expected(i);
+    if (k == kUnknown || k >= kNumClasses) continue;
+    uint8_t c[3];
+    colorAt(i, c);
+    samples_[k].emplace_back(c[0], c[1], c[2]);
+  }
+  const ClusterParams cluster_params = clusterParams();
+  for (int k = 1; k < kNumClasses; ++k) {
+    stats.doublings += clusters_[k].update(samples_[k], cluster_params);
+    stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
+  }
+
+  // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
+  for (size_t i = randomStart(params_.add_stride); i < pixels; i += params_.add_stride) {
+    const uint8_t k = expected(i);
+    if (k == kUnknown || k >= kNumClasses) continue;
+    uint8_t c[3];
+    colorAt(i, c);
+    const ClassCluster& cluster = clusters_[k];
+    if ((cluster.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() < params_.zeta * cluster.sigma()) {
+      const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+      if (lut_.at(cell) != k) {
+        lut_.set(cell, k);
+        ++stats.added[k];
+      }
+    }
+  }
+
+  // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
+  const double safe_range = model_.safeCarpetRange(pose);
+  for (size_t i = randomStart(params_.remove_stride); i < pixels; i += params_.remove_stride) {
+    if (model_.surelyOnCarpet(i, safe_range)) continue;
+    if (model_.geometricClass(i, transform) != kUnknown) continue;
+    ++stats.remove_candidates;
+    uint8_t c[3];
+    colorAt(i, c);
+    const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+    const uint8_t k = lut_.at(cell);
+    if (k == kUnknown || k >= kNumClasses) continue;
+    const ClassCluster& cluster = clusters_[k];
+    if ((cluster.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() > params_.xi * cluster.sigma()) {
+      lut_.set(cell, kUnknown);
+      ++stats.removed[k];
+    }
+  }
+  ++revision_;
+  return stats;
+}
+
+void ActTrainer::bootstrap(const ImageView& image, const Pose2D& pose, int cycles) {
+  for (int i = 0; i < cycles; ++i) cycle(image, pose);
+}
+
+}  // namespace act_color

@@ -1,0 +1,275 @@
+#include "act_color/core/calibration.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <opencv2/core.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+
+namespace act_color {
+namespace {
+
+[[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
+  throw CalibrationError(source + ": " + key + ": " + what);
+}
+
+// Reads one YAML map, remembering which keys were read so that the rest can be rejected.
+class MapReader {
+ public:
+  MapReader(const cv::FileNode& node, std::string path, const std::string& source)
+      : node_(node), path_(std::move(path)), source_(source) {
+    if (node_.empty() || node_.isNone()) fail(source_, path_, "missing");
+    if (!node_.isMap()) fail(source_, path_, "must be a map");
+    std::set<std::string> seen;
+    for (auto it = node_.begin(); it != node_.end(); ++it) {
+      const std::string name = (*it).name();
+      if (!seen.insert(name).second) fail(source_, key(name), "appears twice");
+    }
+  }
+
+  std::string key(const std::string& name) const { return path_.empty() ? name : path_ + "." + name; }
+
+  cv::FileNode child(const std::string& name) {
+    used_.insert(name);
+    cv::FileNode n = node_[name];
+    if (n.empty() || n.isNone()) fail(source_, key(name), "missing");
+    return n;
+  }
+  bool has(const std::string& name) const {
+    cv::FileNode n = node_[name];
+    return !(n.empty() || n.isNone());
+  }
+
+  double number(const cv::FileNode& n, const std::string& k) const {
+    if (!(n.isReal() || n.isInt())) fail(source_, k, "must be a number");
+    const double value = static_cast<double>(n);
+    if (!std::isfinite(value)) fail(source_, k, "must be finite");
+    return value;
+  }
+
+  // A number in [lo, hi] (open at lo when lo_open).
+  double real(const std::string& name, double lo, double hi, bool lo_open = false) {
+    const std::string k = key(name);
+    const double value = number(child(name), k);
+    if ((lo_open ? value <= lo : value < lo) || value > hi) {
+      std::ostringstream s;
+      s << "must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], is " << value;
+      fail(source_, k, s.str());
+    }
+    return value;
+  }
+
+  int integer(const std::string& name, int lo, int hi) {
+    const std::string k = key(name);
+    cv::FileNode n = child(name);
+    if (!n.isInt()) fail(source_, k, "must be an integer");
+    const int value = static_cast<int>(n);
+    if (value < lo || value > hi) {
+      fail(source_, k, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], is " + std::to_string(value));
+    }
+    return value;
+  }
+
+  int sign(const std::string& name) {
+    const std::string k = key(name);
+    cv::FileNode n = child(name);
+    if (!n.isInt() || (static_cast<int>(n) != 1 && static_cast<int>(n) != -1)) fail(source_, k, "must be 1 or -1");
+    return static_cast<int>(n);
+  }
+
+  MapReader map(const std::string& name) { return MapReader(child(name), key(name), source_); }
+
+  void rejectUnknownKeys() const {
+    for (auto it = node_.begin(); it != node_.end(); ++it) {
+      const std::string name = (*it).name();
+      if (!used_.count(name)) fail(source_, key(name), "unknown key");
+    }
+  }
+
+  const std::string& source() const { return source_; }
+
+ private:
+  cv::FileNode node_;
+  std::string path_;
+  std::string source_;
+  std::set<std::string> used_;
+};
+
+std::vector<double> numberSequence(MapReader& reader, const cv::FileNode& n, const std::string& k, size_t size) {
+  if (!n.isSeq() || n.size() != size) fail(reader.source(), k, "must be a list of " + std::to_string(size) + " numbers");
+  std::vector<double> values;
+  for (size_t i = 0; i < size; ++i) values.push_back(reader.number(n[static_cast<int>(i)], k));
+  return values;
+}
+
+CameraCalibration parseCamera(MapReader camera) {
+  CameraCalibration c;
+  c.width = camera.integer("width", 16, 16384);
+  c.height = camera.integer("height", 16, 16384);
+  const auto center = numberSequence(camera, camera.child("center"), camera.key("center"), 2);
+  c.center_u = center[0];
+  c.center_v = center[1];
+  c.bearing_sign = camera.sign("bearing_sign");
+  c.bearing_offset_rad = camera.real("bearing_offset", -2 * M_PI, 2 * M_PI);
+  c.height_m = camera.real("height_m", 0.0, 10.0, true);
+  c.chassis_radius_px = camera.real("chassis_radius_px", 0.0, 1e5);
+  c.mirror_radius_px = camera.real("mirror_radius_px", 0.0, 1e5, true);
+  const cv::FileNode map = camera.child("elevation_map");
+  const std::string map_key = camera.key("elevation_map");
+  if (!map.isSeq() || map.size() < 2) fail(camera.source(), map_key, "must be a list of at least two [r_px, elevation_rad] pairs");
+  for (size_t i = 0; i < map.size(); ++i) {
+    const std::string entry_key = map_key + "[" + std::to_string(i) + "]";
+    const auto pair = numberSequence(camera, map[static_cast<int>(i)], entry_key, 2);
+    c.elevation_map.emplace_back(pair[0], pair[1]);
+  }
+  camera.rejectUnknownKeys();
+  return c;
+}
+
+FieldCalibration parseField(MapReader field) {
+  FieldCalibration f;
+  f.length_m = field.real("length_m", 0.0, 1000.0, true);
+  f.width_m = field.real("width_m", 0.0, 1000.0, true);
+  f.line_width_m = field.real("line_width_m", 0.0, 10.0, true);
+  f.margin_m = field.real("margin_m", 0.0, 100.0);
+  f.center_circle_radius_m = field.real("center_circle_radius_m", 0.0, 1000.0, true);
+  f.corner_arc_radius_m = field.real("corner_arc_radius_m", 0.0, 1000.0, true);
+  {
+    MapReader goal_area = field.map("goal_area");
+    f.goal_area_depth_m = goal_area.real("depth_m", 0.0, 1000.0, true);
+    f.goal_area_width_m = goal_area.real("width_m", 0.0, 1000.0, true);
+    goal_area.rejectUnknownKeys();
+  }
+  {
+    MapReader penalty_area = field.map("penalty_area");
+    f.penalty_area_depth_m = penalty_area.real("depth_m", 0.0, 1000.0, true);
+    f.penalty_area_width_m = penalty_area.real("width_m", 0.0, 1000.0, true);
+    penalty_area.rejectUnknownKeys();
+  }
+  if (field.has("penalty_mark_distance_m")) f.penalty_mark_distance_m = field.real("penalty_mark_distance_m", 0.0, 1000.0, true);
+  {
+    MapReader goal = field.map("goal");
+    f.goal_width_m = goal.real("width_m", 0.0, 1000.0, true);
+    f.goal_height_m = goal.real("height_m", 0.0, 100.0, true);
+    f.goal_depth_m = goal.real("depth_m", 0.0, 100.0, true);
+    goal.rejectUnknownKeys();
+  }
+  f.yellow_goal_x_sign = field.sign("yellow_goal_x_sign");
+  field.rejectUnknownKeys();
+  return f;
+}
+
+std::string fixParserLine(const std::string& message) {
+  // We prepend one line ("%YAML:1.0") for OpenCV's parser; report the file's own line numbers.
+  std::smatch m;
+  static const std::regex kLine("\\((\\d+)\\)");
+  if (std::regex_search(message, m, kLine)) {
+    const int line = std::stoi(m[1]) - 1;
+    return m.prefix().str() + "(line " + std::to_string(line) + ")" + m.suffix().str();
+  }
+  return message;
+}
+
+}  // namespace
+
+Calibration parseCalibration(const std::string& yaml_text, const std::string& source_name) {
+  cv::FileStorage storage;
+  try {
+    storage.open("%YAML:1.0\n" + yaml_text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception& e) {
+    throw CalibrationError(source_name + ": not valid YAML: " + fixParserLine(e.err));
+  }
+  if (!storage.isOpened()) throw CalibrationError(source_name + ": not valid YAML");
+  MapReader root(storage.root(), "", source_name);
+  Calibration calibration;
+  calibration.camera = parseCamera(root.map("camera"));
+  calibration.field = parseField(root.map("field"));
+  root.rejectUnknownKeys();
+  validateCalibration(calibration, source_name);
+  return calibration;
+}
+
+Calibration loadCalibration(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw CalibrationError(path + ": cannot be read");
+  std::stringstream text;
+  text << file.rdbuf();
+  return parseCalibration(text.str(), path);
+}
+
+void validateCalibration(const Calibration& calibration, const std::string& source) {
+  const CameraCalibration& c = calibration.camera;
+  if (c.width < 16 || c.height < 16) fail(source, "camera.width", "image must be at least 16x16 px");
+  if (!(c.center_u >= 0 && c.center_u <= c.width && c.center_v >= 0 && c.center_v <= c.height)) {
+    fail(source, "camera.center", "must lie inside the image");
+  }
+  if (c.bearing_sign != 1 && c.bearing_sign != -1) fail(source, "camera.bearing_sign", "must be 1 or -1");
+  if (!(c.height_m > 0)) fail(source, "camera.height_m", "must be positive");
+  if (!(c.chassis_radius_px < c.mirror_radius_px)) {
+    fail(source, "camera.chassis_radius_px", "must be smaller than camera.mirror_radius_px");
+  }
+  if (c.elevation_map.size() < 2) fail(source, "camera.elevation_map", "needs at least two entries");
+  for (size_t i = 0; i < c.elevation_map.size(); ++i) {
+    const auto& [r, e] = c.elevation_map[i];
+    const std::string key = "camera.elevation_map[" + std::to_string(i) + "]";
+    if (!(r >= 0)) fail(source, key, "r_px must not be negative");
+    if (!(e > -M_PI / 2 && e < M_PI / 2)) fail(source, key, "elevation_rad must be in (-pi/2, pi/2)");
+    if (i > 0 && !(r > c.elevation_map[i - 1].first)) fail(source, key, "r_px must increase strictly");
+    if (i > 0 && !(e > c.elevation_map[i - 1].second)) fail(source, key, "elevation_rad must increase strictly");
+  }
+  if (!(c.elevation_map.front().second < 0)) fail(source, "camera.elevation_map[0]", "must look below the horizon");
+
+  const FieldCalibration& f = calibration.field;
+  if (!(2 * f.line_width_m < std::min(f.length_m, f.width_m))) fail(source, "field.line_width_m", "too wide for the field");
+  if (!(f.center_circle_radius_m < f.width_m / 2 && f.center_circle_radius_m < f.length_m / 2)) {
+    fail(source, "field.center_circle_radius_m", "must fit into the field");
+  }
+  if (!(f.corner_arc_radius_m < f.width_m / 2)) fail(source, "field.corner_arc_radius_m", "must fit into the field");
+  if (!(f.goal_area_width_m < f.width_m)) fail(source, "field.goal_area.width_m", "must be less than field.width_m");
+  if (!(f.goal_area_depth_m < f.length_m / 2)) fail(source, "field.goal_area.depth_m", "must be less than half the length");
+  if (!(f.penalty_area_width_m < f.width_m)) fail(source, "field.penalty_area.width_m", "must be less than field.width_m");
+  if (!(f.penalty_area_depth_m < f.length_m / 2)) {
+    fail(source, "field.penalty_area.depth_m", "must be less than half the length");
+  }
+  if (f.penalty_mark_distance_m && !(*f.penalty_mark_distance_m < f.length_m / 2)) {
+    fail(source, "field.penalty_mark_distance_m", "must be less than half the length");
+  }
+  if (!(f.goal_width_m < f.width_m)) fail(source, "field.goal.width_m", "must be less than field.width_m");
+  if (f.yellow_goal_x_sign != 1 && f.yellow_goal_x_sign != -1) fail(source, "field.yellow_goal_x_sign", "must be 1 or -1");
+}
+
+std::string toYaml(const Calibration& calibration) {
+  const CameraCalibration& c = calibration.camera;
+  const FieldCalibration& f = calibration.field;
+  std::ostringstream s;
+  s << std::setprecision(17);
+  s << "camera:\n"
+    << "  width: " << c.width << "\n"
+    << "  height: " << c.height << "\n"
+    << "  center: [" << c.center_u << ", " << c.center_v << "]\n"
+    << "  bearing_sign: " << c.bearing_sign << "\n"
+    << "  bearing_offset: " << c.bearing_offset_rad << "\n"
+    << "  height_m: " << c.height_m << "\n"
+    << "  chassis_radius_px: " << c.chassis_radius_px << "\n"
+    << "  mirror_radius_px: " << c.mirror_radius_px << "\n"
+    << "  elevation_map:\n";
+  for (const auto& [r, e] : c.elevation_map) s << "    - [" << r << ", " << e << "]\n";
+  s << "field:\n"
+    << "  length_m: " << f.length_m << "\n"
+    << "  width_m: " << f.width_m << "\n"
+    << "  line_width_m: " << f.line_width_m << "\n"
+    << "  margin_m: " << f.margin_m << "\n"
+    << "  center_circle_radius_m: " << f.center_circle_radius_m << "\n"
+    << "  corner_arc_radius_m: " << f.corner_arc_radius_m << "\n"
+    << "  goal_area: {depth_m: " << f.goal_area_depth_m << ", width_m: " << f.goal_area_width_m << "}\n"
+    << "  penalty_area: {depth_m: " << f.penalty_area_depth_m << ", width_m: " << f.penalty_area_width_m << "}\n";
+  if (f.penalty_mark_distance_m) s << "  penalty_mark_distance_m: " << *f.penalty_mark_distance_m << "\n";
+  s << "  goal: {width_m: " << f.goal_width_m << ", height_m: " << f.goal_height_m << ", depth_m: " << f.goal_depth_m
+    << "}\n"
+    << "  yellow_goal_x_sign: " << f.yellow_goal_x_sign << "\n";
+  return s.str();
+}
+
+}  // namespace act_color

@@ -1,0 +1,81 @@
+#include "act_color/core/expected_class_model.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace act_color {
+
+ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
+    : field_(calibration.field), camera_(calibration.camera) {
+  ground_range_m_.resize(camera_.rays().size());
+  for (size_t i = 0; i < ground_range_m_.size(); ++i) {
+    const PixelRay& ray = camera_.ray(i);
+    ground_range_m_[i] = ray.region == PixelRegion::kFloor ? std::hypot(ray.ground_x_m, ray.ground_y_m)
+                                                            : std::numeric_limits<float>::infinity();
+  }
+}
+
+uint8_t ExpectedClassModel::geometricClass(size_t pixel_index, const PoseTransform& pose) const {
+  const PixelRay& ray = camera_.ray(pixel_index);
+  switch (ray.region) {
+    case PixelRegion::kNotImaged:
+      return kNotImaged;
+    case PixelRegion::kChassis:
+      return kBlack;
+    case PixelRegion::kFloor:
+    case PixelRegion::kAboveHorizon:
+      break;
+  }
+  const Eigen::Vector3d origin(pose.x_m, pose.y_m, camera_.viewpointHeight());
+  const Eigen::Vector3d dir(pose.cos_theta * ray.dir_x - pose.sin_theta * ray.dir_y,
+                            pose.sin_theta * ray.dir_x + pose.cos_theta * ray.dir_y, ray.dir_z);
+  if (ray.region == PixelRegion::kAboveHorizon) {
+    return field_.goalHit(origin, dir, std::numeric_limits<double>::infinity());
+  }
+  double fx, fy;
+  pose.apply(ray.ground_x_m, ray.ground_y_m, &fx, &fy);
+  // A ray can only pass through a goal box if it reaches beyond a goal line.
+  if (std::abs(fx) >= field_.halfLength() || std::abs(pose.x_m) >= field_.halfLength()) {
+    const double t_floor = camera_.viewpointHeight() / -dir.z();
+    const ColorClass goal = field_.goalHit(origin, dir, t_floor);
+    if (goal != kUnknown) return goal;
+  }
+  return field_.floorClass(fx, fy);
+}
+
+double ExpectedClassModel::safeCarpetRange(const Pose2D& pose) const {
+  const FieldCalibration& f = field_.calibration();
+  const double ax = std::abs(pose.x_m);
+  const double ay = std::abs(pose.y_m);
+  double range = std::min(field_.halfLength() + f.margin_m - ax, field_.halfWidth() + f.margin_m - ay);
+  // Distance to the goal boxes' footprints (both lie at |x| >= half length, |y| <= width / 2).
+  const double dx = std::max(0.0, field_.halfLength() - ax);
+  const double dy = std::max(0.0, ay - f.goal_width_m / 2);
+  range = std::min(range, std::hypot(dx, dy));
+  return std::max(0.0, range);
+}
+
+bool ExpectedClassModel::brighterThanNeighbourhood(const ImageView& image, int u, int v) {
+  if (u < 2 || v < 2 || u >= image.width - 2 || v >= image.height - 2) return false;
+  int sum = 0;
+  for (int j = v - 2; j <= v + 2; ++j) {
+    for (int i = u - 2; i <= u + 2; ++i) sum += image.intensity(i, j);
+  }
+  return 25 * image.intensity(u, v) > sum;  // eq. 1, without the division
+}
+
+cv::Mat ExpectedClassModel::expectedLabels(const ImageView& image, const Pose2D& pose) const {
+  cv::Mat labels(camera_.height(), camera_.width(), CV_8UC1);
+  const PoseTransform transform(pose);
+  for (int v = 0; v < camera_.height(); ++v) {
+    uint8_t* row = labels.ptr<uint8_t>(v);
+    for (int u = 0; u < camera_.width(); ++u) {
+      uint8_t c = geometricClass(static_cast<size_t>(v) * camera_.width() + u, transform);
+      if (c == kWhite && !brighterThanNeighbourhood(image, u, v)) c = kRejectedWhite;
+      row[u] = c;
+    }
+  }
+  return labels;
+}
+
+}  // namespace act_color

@@ -1,0 +1,92 @@
+#include "act_color/core/field_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace act_color {
+
+FieldModel::FieldModel(const FieldCalibration& field)
+    : field_(field),
+      half_length_m_(field.length_m / 2),
+      half_width_m_(field.width_m / 2),
+      carpet_half_length_m_(field.length_m / 2 + field.margin_m),
+      carpet_half_width_m_(field.width_m / 2 + field.margin_m) {
+  // Goals stand behind the goal lines' outer edges; index 0 is yellow, 1 blue.
+  for (int i = 0; i < 2; ++i) {
+    const double sign = (i == 0 ? 1.0 : -1.0) * field.yellow_goal_x_sign;
+    const double x_near = sign * half_length_m_;
+    const double x_far = sign * (half_length_m_ + field.goal_depth_m);
+    goal_min_[i] = Eigen::Vector3d(std::min(x_near, x_far), -field.goal_width_m / 2, 0.0);
+    goal_max_[i] = Eigen::Vector3d(std::max(x_near, x_far), field.goal_width_m / 2, field.goal_height_m);
+  }
+}
+
+bool FieldModel::isLine(double x_m, double y_m) const {
+  const double ax = std::abs(x_m);
+  const double ay = std::abs(y_m);
+  const double lw = field_.line_width_m;
+  const double hl = half_length_m_;
+  const double hw = half_width_m_;
+  if (ax > hl || ay > hw) return false;        // margin: no markings
+  if (ay >= hw - lw || ax >= hl - lw) return true;  // side and goal lines
+  if (ax <= lw / 2) return true;                // halfway line
+  const double r = std::hypot(x_m, y_m);
+  if (r <= field_.center_circle_radius_m && r >= field_.center_circle_radius_m - lw) return true;
+  // Goal and penalty areas: outer edges at the given depth and width.
+  for (const auto& [depth, width] : {std::make_pair(field_.goal_area_depth_m, field_.goal_area_width_m),
+                                     std::make_pair(field_.penalty_area_depth_m, field_.penalty_area_width_m)}) {
+    const double x_inner = hl - depth;
+    if (ay <= width / 2 && ax >= x_inner && ax <= x_inner + lw) return true;
+    if (ax >= x_inner && ay <= width / 2 && ay >= width / 2 - lw) return true;
+  }
+  const double corner = std::hypot(hl - ax, hw - ay);
+  if (corner <= field_.corner_arc_radius_m && corner >= field_.corner_arc_radius_m - lw) return true;
+  if (field_.penalty_mark_distance_m) {
+    if (std::hypot(ax - (hl - *field_.penalty_mark_distance_m), y_m) <= lw / 2) return true;
+  }
+  return false;
+}
+
+ColorClass FieldModel::floorClass(double x_m, double y_m) const {
+  if (!onCarpet(x_m, y_m)) return kUnknown;
+  return isLine(x_m, y_m) ? kWhite : kGreen;
+}
+
+ColorClass FieldModel::goalHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
+                               double* t_hit) const {
+  ColorClass best = kUnknown;
+  double best_t = t_max;
+  for (int i = 0; i < 2; ++i) {
+    // Slab test against the axis-aligned goal box.
+    double t0 = 0.0;
+    double t1 = best_t;
+    bool hit = true;
+    for (int a = 0; a < 3 && hit; ++a) {
+      if (std::abs(dir[a]) < 1e-12) {
+        hit = origin[a] >= goal_min_[i][a] && origin[a] <= goal_max_[i][a];
+        continue;
+      }
+      double ta = (goal_min_[i][a] - origin[a]) / dir[a];
+      double tb = (goal_max_[i][a] - origin[a]) / dir[a];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+      hit = t0 <= t1;
+    }
+    if (hit && t0 < best_t) {
+      best_t = t0;
+      best = i == 0 ? kYellow : kBlue;
+    }
+  }
+  if (t_hit) *t_hit = best_t;
+  return best;
+}
+
+void FieldModel::goalBox(ColorClass goal, Eigen::Vector3d* min_corner, Eigen::Vector3d* max_corner) const {
+  const int i = goal == kYellow ? 0 : 1;
+  *min_corner = goal_min_[i];
+  *max_corner = goal_max_[i];
+}
+
+}  // namespace act_color

@@ -1,0 +1,109 @@
+#include "act_color/core/segmenter.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace act_color {
+
+Segmenter::Segmenter(const CameraCalibration& camera) : width_(camera.width), height_(camera.height) {
+  // Inside the mirror: r <= mirror radius (and the elevation table's end), as OmniCameraModel.
+  const double r_max = std::min(camera.mirror_radius_px, camera.elevation_map.back().first);
+  spans_.resize(height_);
+  for (int v = 0; v < height_; ++v) {
+    const double dv = v - camera.center_v;
+    const double half_sq = r_max * r_max - dv * dv;
+    if (half_sq < 0) {
+      spans_[v] = {0, 0};
+      continue;
+    }
+    const double half = std::sqrt(half_sq);
+    const int u0 = std::max(0, static_cast<int>(std::ceil(camera.center_u - half)));
+    const int u1 = std::min(width_, static_cast<int>(std::floor(camera.center_u + half)) + 1);
+    spans_[v] = {u0, std::max(u0, u1)};
+  }
+}
+
+namespace {
+
+template <int I0, int I1, int I2, int kBytes>
+void classifyRgbRow(const uint8_t* in, uint8_t* out, int u0, int u1, const uint8_t* table, int bits) {
+  const int shift = 8 - bits;
+  const int s1 = bits;
+  const int s0 = 2 * bits;
+  for (int u = u0; u < u1; ++u) {
+    const uint8_t* p = in + kBytes * u;
+    const uint32_t idx = (static_cast<uint32_t>(p[I0] >> shift) << s0) | (static_cast<uint32_t>(p[I1] >> shift) << s1) |
+                         static_cast<uint32_t>(p[I2] >> shift);
+    out[u] = table[idx];
+  }
+}
+
+void classifyUyvyRow(const uint8_t* in, uint8_t* out, int u0, int u1, const uint8_t* table, int bits) {
+  const int shift = 8 - bits;
+  for (int u = u0; u < u1; ++u) {
+    const uint8_t* p = in + 4 * (u >> 1);
+    const uint8_t y = p[(u & 1) ? 3 : 1];
+    const uint32_t idx = (static_cast<uint32_t>(y >> shift) << (2 * bits)) | (static_cast<uint32_t>(p[0] >> shift) << bits) |
+                         static_cast<uint32_t>(p[2] >> shift);
+    out[u] = table[idx];
+  }
+}
+
+}  // namespace
+
+void Segmenter::classify(const ColorLut& lut, const ImageView& image, cv::Mat& labels) const {
+  if (lut.colorSpace() != nativeColorSpace(image.format)) {
+    throw std::invalid_argument(std::string("the table's color space does not fit ") + encodingName(image.format) + " images");
+  }
+  if (!spans_.empty() && (image.width != width_ || image.height != height_)) {
+    throw std::invalid_argument("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+                                " px, the calibration is for " + std::to_string(width_) + "x" + std::to_string(height_));
+  }
+  labels.create(image.height, image.width, CV_8UC1);
+  const uint8_t* table = lut.data();
+  const int bits = lut.bitsPerChannel();
+  for (int v = 0; v < image.height; ++v) {
+    const uint8_t* in = image.data + static_cast<size_t>(v) * image.step;
+    uint8_t* out = labels.ptr<uint8_t>(v);
+    int u0 = 0, u1 = image.width;
+    if (!spans_.empty()) {
+      u0 = spans_[v].first;
+      u1 = spans_[v].second;
+      std::fill(out, out + u0, static_cast<uint8_t>(kUnknown));
+      std::fill(out + u1, out + image.width, static_cast<uint8_t>(kUnknown));
+    }
+    switch (image.format) {
+      case PixelFormat::kRgb8:
+        classifyRgbRow<0, 1, 2, 3>(in, out, u0, u1, table, bits);
+        break;
+      case PixelFormat::kBgr8:
+        classifyRgbRow<2, 1, 0, 3>(in, out, u0, u1, table, bits);
+        break;
+      case PixelFormat::kUyvy:
+        classifyUyvyRow(in, out, u0, u1, table, bits);
+        break;
+    }
+  }
+}
+
+void colorizeLabels(const cv::Mat& labels, cv::Mat& rgb) {
+  CV_Assert(labels.type() == CV_8UC1);
+  rgb.create(labels.rows, labels.cols, CV_8UC3);
+  const auto& palette = classPalette();
+  for (int v = 0; v < labels.rows; ++v) {
+    const uint8_t* in = labels.ptr<uint8_t>(v);
+    uint8_t* out = rgb.ptr<uint8_t>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      const uint8_t c = in[u];
+      if (c < kNumClasses) {
+        out[3 * u] = palette[c][0];
+        out[3 * u + 1] = palette[c][1];
+        out[3 * u + 2] = palette[c][2];
+      } else {
+        out[3 * u] = out[3 * u + 1] = out[3 * u + 2] = 40;
+      }
+    }
+  }
+}
+
+}  // namespace act_color

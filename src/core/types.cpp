@@ -1,0 +1,24 @@
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+
+const char* className(int class_id) {
+  static const char* const kNames[kNumClasses] = {"unknown", "green", "white", "yellow", "blue", "black", "orange"};
+  if (class_id >= 0 && class_id < kNumClasses) return kNames[class_id];
+  return class_id == kNotImaged ? "not_imaged" : "invalid";
+}
+
+const std::array<std::array<uint8_t, 3>, kNumClasses>& classPalette() {
+  static const std::array<std::array<uint8_t, 3>, kNumClasses> kPalette = {{
+      {{128, 128, 128}},  // unknown
+      {{0, 170, 0}},      // green
+      {{255, 255, 255}},  // white
+      {{255, 230, 0}},    // yellow
+      {{0, 60, 255}},     // blue
+      {{0, 0, 0}},        // black
+      {{255, 120, 0}},    // orange
+  }};
+  return kPalette;
+}
+
+}  // namespace act_color
