@@ -1,0 +1,34 @@
+#pragma once
+
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <sensor_msgs/Image.h>
+
+#include <string>
+
+#include "act_color/ColorLut.h"
+#include "act_color/core/act_trainer.hpp"
+#include "act_color/core/color_lut.hpp"
+#include "act_color/core/image_view.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+namespace ros_conversions {
+
+// A view of a sensor_msgs/Image (rgb8, bgr8, yuv422); false with a reason for anything else.
+bool imageView(const sensor_msgs::Image& image, ImageView* view, std::string* error);
+
+// The table and clusters of a trainer as a message (the table is copied once).
+act_color::ColorLutPtr toMsg(const ActTrainer& trainer, const std_msgs::Header& header);
+
+// The table of a message; false with a reason when the message is inconsistent.
+bool fromMsg(const act_color::ColorLut& msg, ColorLut* lut, std::string* error);
+
+// Pose of base_link in field from a pose message; false with a reason for NaN/inf or a
+// non-planar orientation that cannot be reduced to a yaw.
+bool pose2D(const geometry_msgs::Pose& pose, Pose2D* out, std::string* error);
+
+// mono8 label image message with the given header (copies the labels once).
+sensor_msgs::ImagePtr labelsToMsg(const cv::Mat& labels, const std_msgs::Header& header);
+
+}  // namespace ros_conversions
+}  // namespace act_color

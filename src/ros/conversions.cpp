@@ -1,0 +1,111 @@
+#include "act_color/ros/conversions.hpp"
+
+#include <cmath>
+
+namespace act_color {
+namespace ros_conversions {
+
+bool imageView(const sensor_msgs::Image& image, ImageView* view, std::string* error) {
+  PixelFormat format;
+  if (!pixelFormatFromEncoding(image.encoding, &format)) {
+    *error = "unsupported encoding '" + image.encoding + "' (expected rgb8, bgr8 or yuv422)";
+    return false;
+  }
+  const size_t bytes_per_pixel = format == PixelFormat::kUyvy ? 2 : 3;
+  if (image.width == 0 || image.height == 0) {
+    *error = "empty image";
+    return false;
+  }
+  if (image.step < bytes_per_pixel * image.width || image.data.size() < static_cast<size_t>(image.step) * image.height) {
+    *error = "image data is shorter than step * height";
+    return false;
+  }
+  if (format == PixelFormat::kUyvy && image.width % 2 != 0) {
+    *error = "yuv422 image with an odd width";
+    return false;
+  }
+  *view = ImageView(image.data.data(), static_cast<int>(image.width), static_cast<int>(image.height), image.step, format);
+  return true;
+}
+
+act_color::ColorLutPtr toMsg(const ActTrainer& trainer, const std_msgs::Header& header) {
+  auto msg = boost::make_shared<act_color::ColorLut>();
+  const ColorLut& lut = trainer.lut();
+  msg->header = header;
+  msg->color_space =
+      lut.colorSpace() == ColorSpace::kYuv ? act_color::ColorLut::COLOR_SPACE_YUV : act_color::ColorLut::COLOR_SPACE_RGB;
+  msg->bits_per_channel = static_cast<uint8_t>(lut.bitsPerChannel());
+  msg->revision = trainer.revision();
+  msg->table = lut.table();
+  const auto counts = lut.cellCounts();
+  for (int k = 1; k < kNumClasses; ++k) {
+    const ClassCluster& cluster = trainer.clusters()[k];
+    act_color::ClassCluster c;
+    c.class_id = static_cast<uint8_t>(k);
+    for (int i = 0; i < 3; ++i) c.mean[i] = static_cast<float>(cluster.mean()[i]);
+    c.sigma = static_cast<float>(cluster.sigma());
+    c.samples = cluster.lastSampleCount();
+    c.lut_cells = counts[k];
+    msg->clusters.push_back(c);
+  }
+  return msg;
+}
+
+bool fromMsg(const act_color::ColorLut& msg, ColorLut* lut, std::string* error) {
+  if (msg.bits_per_channel < 1 || msg.bits_per_channel > 8) {
+    *error = "bits_per_channel must be in [1, 8]";
+    return false;
+  }
+  if (msg.color_space != act_color::ColorLut::COLOR_SPACE_RGB && msg.color_space != act_color::ColorLut::COLOR_SPACE_YUV) {
+    *error = "unknown color_space " + std::to_string(msg.color_space);
+    return false;
+  }
+  ColorLut out(msg.bits_per_channel,
+               msg.color_space == act_color::ColorLut::COLOR_SPACE_YUV ? ColorSpace::kYuv : ColorSpace::kRgb);
+  if (msg.table.size() != out.size()) {
+    *error = "table has " + std::to_string(msg.table.size()) + " cells, expected " + std::to_string(out.size());
+    return false;
+  }
+  out.assign(msg.table);
+  *lut = std::move(out);
+  return true;
+}
+
+bool pose2D(const geometry_msgs::Pose& pose, Pose2D* out, std::string* error) {
+  const auto& p = pose.position;
+  const auto& q = pose.orientation;
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z) ||
+      !std::isfinite(q.w)) {
+    *error = "pose has NaN or infinite values";
+    return false;
+  }
+  const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  if (norm < 1e-6) {
+    *error = "pose orientation is a zero quaternion";
+    return false;
+  }
+  // Yaw of a planar pose; a robot on the floor does not roll or pitch noticeably.
+  const double x = q.x / norm, y = q.y / norm, z = q.z / norm, w = q.w / norm;
+  out->x_m = p.x;
+  out->y_m = p.y;
+  out->theta_rad = std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+  return true;
+}
+
+sensor_msgs::ImagePtr labelsToMsg(const cv::Mat& labels, const std_msgs::Header& header) {
+  auto msg = boost::make_shared<sensor_msgs::Image>();
+  msg->header = header;
+  msg->height = static_cast<uint32_t>(labels.rows);
+  msg->width = static_cast<uint32_t>(labels.cols);
+  msg->encoding = "mono8";
+  msg->is_bigendian = 0;
+  msg->step = static_cast<uint32_t>(labels.cols);
+  msg->data.resize(static_cast<size_t>(labels.rows) * labels.cols);
+  for (int v = 0; v < labels.rows; ++v) {
+    std::copy(labels.ptr<uint8_t>(v), labels.ptr<uint8_t>(v) + labels.cols, msg->data.begin() + static_cast<size_t>(v) * labels.cols);
+  }
+  return msg;
+}
+
+}  // namespace ros_conversions
+}  // namespace act_color
