@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 namespace act_color {
+namespace core {
 namespace {
 
 void requireRange(const char* name, double value, double lo, double hi, bool lo_open = false) {
@@ -167,4 +168,5 @@ void ActTrainer::bootstrap(const ImageView& image, const Pose2D& pose, int cycle
   for (int i = 0; i < cycles; ++i) cycle(image, pose);
 }
 
+}  // namespace core
 }  // namespace act_color

@@ -9,6 +9,7 @@
 #include <sstream>
 
 namespace act_color {
+namespace core {
 namespace {
 
 [[noreturn]] void fail(const std::string& source, const std::string& key, const std::string& what) {
@@ -272,4 +273,5 @@ std::string toYaml(const Calibration& calibration) {
   return s.str();
 }
 
+}  // namespace core
 }  // namespace act_color

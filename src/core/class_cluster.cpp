@@ -4,6 +4,7 @@
 #include <cmath>
 
 namespace act_color {
+namespace core {
 
 void ClassCluster::reset(double max_value) {
   mean_ = Eigen::Vector3d::Constant(0.5 * max_value);  // eq. 2
@@ -44,4 +45,5 @@ void ClassCluster::set(const Eigen::Vector3d& mean, double sigma, bool trained) 
   trained_ = trained;
 }
 
+}  // namespace core
 }  // namespace act_color

@@ -5,6 +5,7 @@
 #include <string>
 
 namespace act_color {
+namespace core {
 
 ColorLut::ColorLut(int bits_per_channel, ColorSpace space) : bits_(bits_per_channel), shift_(8 - bits_per_channel), space_(space) {
   if (bits_per_channel < 1 || bits_per_channel > 8) {
@@ -30,4 +31,5 @@ void ColorLut::assign(const std::vector<uint8_t>& table) {
   table_ = table;
 }
 
+}  // namespace core
 }  // namespace act_color

@@ -4,6 +4,7 @@
 #include <limits>
 
 namespace act_color {
+namespace core {
 
 ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
     : field_(calibration.field), camera_(calibration.camera) {
@@ -78,4 +79,5 @@ cv::Mat ExpectedClassModel::expectedLabels(const ImageView& image, const Pose2D&
   return labels;
 }
 
+}  // namespace core
 }  // namespace act_color

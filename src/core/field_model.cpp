@@ -5,6 +5,7 @@
 #include <limits>
 
 namespace act_color {
+namespace core {
 
 FieldModel::FieldModel(const FieldCalibration& field)
     : field_(field),
@@ -89,4 +90,5 @@ void FieldModel::goalBox(ColorClass goal, Eigen::Vector3d* min_corner, Eigen::Ve
   *max_corner = goal_max_[i];
 }
 
+}  // namespace core
 }  // namespace act_color

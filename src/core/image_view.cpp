@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 namespace act_color {
+namespace core {
 
 ColorSpace nativeColorSpace(PixelFormat format) { return format == PixelFormat::kUyvy ? ColorSpace::kYuv : ColorSpace::kRgb; }
 
@@ -64,4 +65,5 @@ cv::Mat rgbToUyvy(const cv::Mat& rgb) {
   return out;
 }
 
+}  // namespace core
 }  // namespace act_color

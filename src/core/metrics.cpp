@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 namespace act_color {
+namespace core {
 
 void ClassificationMetrics::add(const cv::Mat& labels, const cv::Mat& truth) {
   if (labels.type() != CV_8UC1 || truth.type() != CV_8UC1 || labels.size() != truth.size()) {
@@ -72,4 +73,5 @@ const std::vector<int>& trainableClasses() {
   return kClasses;
 }
 
+}  // namespace core
 }  // namespace act_color

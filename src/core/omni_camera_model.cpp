@@ -4,6 +4,7 @@
 #include <limits>
 
 namespace act_color {
+namespace core {
 
 OmniCameraModel::OmniCameraModel(const CameraCalibration& camera) : camera_(camera) {
   rays_.resize(static_cast<size_t>(camera_.width) * camera_.height);
@@ -80,4 +81,5 @@ bool OmniCameraModel::projectFloorPoint(double x_m, double y_m, double* u, doubl
   return projectDirection(std::atan2(y_m, x_m), -std::atan(camera_.height_m / ground), u, v);
 }
 
+}  // namespace core
 }  // namespace act_color

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 namespace act_color {
+namespace core {
 
 Segmenter::Segmenter(const CameraCalibration& camera) : width_(camera.width), height_(camera.height) {
   // Inside the mirror: r <= mirror radius (and the elevation table's end), as OmniCameraModel.
@@ -106,4 +107,5 @@ void colorizeLabels(const cv::Mat& labels, cv::Mat& rgb) {
   }
 }
 
+}  // namespace core
 }  // namespace act_color

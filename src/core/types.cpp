@@ -1,6 +1,7 @@
 #include "act_color/core/types.hpp"
 
 namespace act_color {
+namespace core {
 
 const char* className(int class_id) {
   static const char* const kNames[kNumClasses] = {"unknown", "green", "white", "yellow", "blue", "black", "orange"};
@@ -21,4 +22,5 @@ const std::array<std::array<uint8_t, 3>, kNumClasses>& classPalette() {
   return kPalette;
 }
 
+}  // namespace core
 }  // namespace act_color

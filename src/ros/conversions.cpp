@@ -1,17 +1,18 @@
 #include "act_color/ros/conversions.hpp"
 
+#include <boost/make_shared.hpp>
 #include <cmath>
 
 namespace act_color {
 namespace ros_conversions {
 
-bool imageView(const sensor_msgs::Image& image, ImageView* view, std::string* error) {
-  PixelFormat format;
-  if (!pixelFormatFromEncoding(image.encoding, &format)) {
+bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::string* error) {
+  core::PixelFormat format;
+  if (!core::pixelFormatFromEncoding(image.encoding, &format)) {
     *error = "unsupported encoding '" + image.encoding + "' (expected rgb8, bgr8 or yuv422)";
     return false;
   }
-  const size_t bytes_per_pixel = format == PixelFormat::kUyvy ? 2 : 3;
+  const size_t bytes_per_pixel = format == core::PixelFormat::kUyvy ? 2 : 3;
   if (image.width == 0 || image.height == 0) {
     *error = "empty image";
     return false;
@@ -20,26 +21,26 @@ bool imageView(const sensor_msgs::Image& image, ImageView* view, std::string* er
     *error = "image data is shorter than step * height";
     return false;
   }
-  if (format == PixelFormat::kUyvy && image.width % 2 != 0) {
+  if (format == core::PixelFormat::kUyvy && image.width % 2 != 0) {
     *error = "yuv422 image with an odd width";
     return false;
   }
-  *view = ImageView(image.data.data(), static_cast<int>(image.width), static_cast<int>(image.height), image.step, format);
+  *view = core::ImageView(image.data.data(), static_cast<int>(image.width), static_cast<int>(image.height), image.step, format);
   return true;
 }
 
-act_color::ColorLutPtr toMsg(const ActTrainer& trainer, const std_msgs::Header& header) {
+act_color::ColorLutPtr toMsg(const core::ActTrainer& trainer, const std_msgs::Header& header) {
   auto msg = boost::make_shared<act_color::ColorLut>();
-  const ColorLut& lut = trainer.lut();
+  const core::ColorLut& lut = trainer.lut();
   msg->header = header;
   msg->color_space =
-      lut.colorSpace() == ColorSpace::kYuv ? act_color::ColorLut::COLOR_SPACE_YUV : act_color::ColorLut::COLOR_SPACE_RGB;
+      lut.colorSpace() == core::ColorSpace::kYuv ? act_color::ColorLut::COLOR_SPACE_YUV : act_color::ColorLut::COLOR_SPACE_RGB;
   msg->bits_per_channel = static_cast<uint8_t>(lut.bitsPerChannel());
   msg->revision = trainer.revision();
   msg->table = lut.table();
   const auto counts = lut.cellCounts();
-  for (int k = 1; k < kNumClasses; ++k) {
-    const ClassCluster& cluster = trainer.clusters()[k];
+  for (int k = 1; k < core::kNumClasses; ++k) {
+    const core::ClassCluster& cluster = trainer.clusters()[k];
     act_color::ClassCluster c;
     c.class_id = static_cast<uint8_t>(k);
     for (int i = 0; i < 3; ++i) c.mean[i] = static_cast<float>(cluster.mean()[i]);
@@ -51,7 +52,7 @@ act_color::ColorLutPtr toMsg(const ActTrainer& trainer, const std_msgs::Header& 
   return msg;
 }
 
-bool fromMsg(const act_color::ColorLut& msg, ColorLut* lut, std::string* error) {
+bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* error) {
   if (msg.bits_per_channel < 1 || msg.bits_per_channel > 8) {
     *error = "bits_per_channel must be in [1, 8]";
     return false;
@@ -60,8 +61,8 @@ bool fromMsg(const act_color::ColorLut& msg, ColorLut* lut, std::string* error) 
     *error = "unknown color_space " + std::to_string(msg.color_space);
     return false;
   }
-  ColorLut out(msg.bits_per_channel,
-               msg.color_space == act_color::ColorLut::COLOR_SPACE_YUV ? ColorSpace::kYuv : ColorSpace::kRgb);
+  core::ColorLut out(msg.bits_per_channel,
+               msg.color_space == act_color::ColorLut::COLOR_SPACE_YUV ? core::ColorSpace::kYuv : core::ColorSpace::kRgb);
   if (msg.table.size() != out.size()) {
     *error = "table has " + std::to_string(msg.table.size()) + " cells, expected " + std::to_string(out.size());
     return false;
@@ -71,7 +72,7 @@ bool fromMsg(const act_color::ColorLut& msg, ColorLut* lut, std::string* error) 
   return true;
 }
 
-bool pose2D(const geometry_msgs::Pose& pose, Pose2D* out, std::string* error) {
+bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* error) {
   const auto& p = pose.position;
   const auto& q = pose.orientation;
   if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z) ||

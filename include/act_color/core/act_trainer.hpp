@@ -14,6 +14,7 @@
 #include "act_color/core/types.hpp"
 
 namespace act_color {
+namespace core {
 
 // Parameters of ACT; defaults are the paper's. validate() throws std::invalid_argument naming
 // the parameter and its allowed range.
@@ -82,4 +83,5 @@ class ActTrainer {
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
 };
 
+}  // namespace core
 }  // namespace act_color

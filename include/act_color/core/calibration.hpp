@@ -7,6 +7,7 @@
 #include <vector>
 
 namespace act_color {
+namespace core {
 
 // The camera-to-world mapping of the contract's calibration file.
 struct CameraCalibration {
@@ -64,4 +65,5 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
 // YAML text in the contract's format; parseCalibration(toYaml(c)) == c.
 std::string toYaml(const Calibration& calibration);
 
+}  // namespace core
 }  // namespace act_color

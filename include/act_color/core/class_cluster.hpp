@@ -4,6 +4,7 @@
 #include <vector>
 
 namespace act_color {
+namespace core {
 
 // Parameters of the cluster update (paper, section 2.2).
 struct ClusterParams {
@@ -43,4 +44,5 @@ class ClassCluster {
   bool trained_ = false;
 };
 
+}  // namespace core
 }  // namespace act_color

@@ -8,6 +8,7 @@
 #include "act_color/core/types.hpp"
 
 namespace act_color {
+namespace core {
 
 // Color look-up table: one class id per cell of a color space quantised to `bits` per channel.
 class ColorLut {
@@ -42,4 +43,5 @@ class ColorLut {
   std::vector<uint8_t> table_;
 };
 
+}  // namespace core
 }  // namespace act_color

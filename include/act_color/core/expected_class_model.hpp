@@ -10,6 +10,7 @@
 #include "act_color/core/types.hpp"
 
 namespace act_color {
+namespace core {
 
 // Expected-label value of a pixel the field model puts on a line but that fails eq. 1.
 constexpr uint8_t kRejectedWhite = 254;
@@ -61,4 +62,5 @@ class ExpectedClassModel {
   std::vector<float> ground_range_m_;
 };
 
+}  // namespace core
 }  // namespace act_color

@@ -6,6 +6,7 @@
 #include "act_color/core/types.hpp"
 
 namespace act_color {
+namespace core {
 
 // The static world of a 2007-rules MSL field in the `field` frame: carpet, lines and marks, the
 // green margin and the two goals as solid colored boxes behind the goal lines.
@@ -45,4 +46,5 @@ class FieldModel {
   Eigen::Vector3d goal_max_[2];
 };
 
+}  // namespace core
 }  // namespace act_color

@@ -6,6 +6,7 @@
 #include <string>
 
 namespace act_color {
+namespace core {
 
 // Pixel layouts the package accepts (ROS encodings rgb8, bgr8, yuv422 = UYVY).
 enum class PixelFormat : uint8_t { kRgb8 = 0, kBgr8 = 1, kUyvy = 2 };
@@ -69,4 +70,5 @@ struct ImageView {
 // simulator's yuv422 output.
 cv::Mat rgbToUyvy(const cv::Mat& rgb);
 
+}  // namespace core
 }  // namespace act_color

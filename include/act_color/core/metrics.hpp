@@ -9,6 +9,7 @@
 #include "act_color/core/types.hpp"
 
 namespace act_color {
+namespace core {
 
 // Confusion counts of label images against truth; truth pixels of kNotImaged are skipped.
 class ClassificationMetrics {
@@ -37,4 +38,5 @@ class ClassificationMetrics {
 // The classes ACT can train: green, white, yellow, blue, black.
 const std::vector<int>& trainableClasses();
 
+}  // namespace core
 }  // namespace act_color

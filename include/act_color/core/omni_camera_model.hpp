@@ -6,6 +6,7 @@
 #include "act_color/core/calibration.hpp"
 
 namespace act_color {
+namespace core {
 
 // What a pixel of the omnidirectional camera looks at.
 enum class PixelRegion : uint8_t {
@@ -60,4 +61,5 @@ class OmniCameraModel {
   std::vector<PixelRay> rays_;
 };
 
+}  // namespace core
 }  // namespace act_color

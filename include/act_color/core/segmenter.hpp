@@ -8,6 +8,7 @@
 #include "act_color/core/image_view.hpp"
 
 namespace act_color {
+namespace core {
 
 // Classifies whole images with a look-up table.
 class Segmenter {
@@ -32,4 +33,5 @@ class Segmenter {
 // Class ids to the rgb8 palette of classPalette(); 255 (not imaged) becomes dark grey.
 void colorizeLabels(const cv::Mat& labels, cv::Mat& rgb);
 
+}  // namespace core
 }  // namespace act_color

@@ -6,6 +6,7 @@
 #include <string>
 
 namespace act_color {
+namespace core {
 
 // Class ids of the contract (README, "Color classes"). Label images hold these values.
 enum ColorClass : uint8_t {
@@ -35,4 +36,5 @@ struct Pose2D {
   bool isFinite() const { return std::isfinite(x_m) && std::isfinite(y_m) && std::isfinite(theta_rad); }
 };
 
+}  // namespace core
 }  // namespace act_color

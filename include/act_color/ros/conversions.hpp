@@ -15,17 +15,17 @@ namespace act_color {
 namespace ros_conversions {
 
 // A view of a sensor_msgs/Image (rgb8, bgr8, yuv422); false with a reason for anything else.
-bool imageView(const sensor_msgs::Image& image, ImageView* view, std::string* error);
+bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::string* error);
 
 // The table and clusters of a trainer as a message (the table is copied once).
-act_color::ColorLutPtr toMsg(const ActTrainer& trainer, const std_msgs::Header& header);
+act_color::ColorLutPtr toMsg(const core::ActTrainer& trainer, const std_msgs::Header& header);
 
 // The table of a message; false with a reason when the message is inconsistent.
-bool fromMsg(const act_color::ColorLut& msg, ColorLut* lut, std::string* error);
+bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* error);
 
 // Pose of base_link in field from a pose message; false with a reason for NaN/inf or a
 // non-planar orientation that cannot be reduced to a yaw.
-bool pose2D(const geometry_msgs::Pose& pose, Pose2D* out, std::string* error);
+bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* error);
 
 // mono8 label image message with the given header (copies the labels once).
 sensor_msgs::ImagePtr labelsToMsg(const cv::Mat& labels, const std_msgs::Header& header);

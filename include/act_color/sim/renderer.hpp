@@ -62,7 +62,7 @@ struct Lighting {
 };
 
 struct Scene {
-  Pose2D robot_pose;                 // true pose of base_link in the field frame
+  core::Pose2D robot_pose;                 // true pose of base_link in the field frame
   std::vector<RobotObstacle> robots;
   std::optional<Ball> ball;
   Lighting lighting;
@@ -75,12 +75,12 @@ struct Scene {
 // Deterministic: the same calibration, hall seed and scene give the same bytes.
 class Renderer {
  public:
-  explicit Renderer(const Calibration& calibration, uint32_t hall_seed = 7);
+  explicit Renderer(const core::Calibration& calibration, uint32_t hall_seed = 7);
 
-  // rgb8 image and truth labels (class ids, kNotImaged outside the mirror).
+  // rgb8 image and truth labels (class ids, core::kNotImaged outside the mirror).
   LabeledFrame render(const Scene& scene) const;
 
-  const ExpectedClassModel& model() const;
+  const core::ExpectedClassModel& model() const;
 
  private:
   struct Impl;
