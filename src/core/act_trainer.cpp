@@ -58,8 +58,8 @@ void ActTrainer::setParams(const ActParams& params) {
 
 void ActTrainer::loadTable(const ColorLut& lut) {
   if (lut.bitsPerChannel() != params_.lut_bits) {
-    throw std::invalid_argument("table has " + std::to_string(lut.bitsPerChannel()) + " bits per channel, lut_bits is " +
-                                std::to_string(params_.lut_bits));
+    throw std::invalid_argument("table has " + std::to_string(lut.bitsPerChannel()) +
+                                " bits per channel, lut_bits is " + std::to_string(params_.lut_bits));
   }
   lut_ = lut;
   space_known_ = true;
@@ -84,7 +84,8 @@ void ActTrainer::checkImage(const ImageView& image) const {
   }
   const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
   if (image.step < bytes_per_pixel * image.width) throw std::invalid_argument("image row step is too small");
-  if (image.format == PixelFormat::kUyvy && image.width % 2 != 0) throw std::invalid_argument("yuv422 needs an even width");
+  if (image.format == PixelFormat::kUyvy && image.width % 2 != 0)
+    throw std::invalid_argument("yuv422 needs an even width");
 }
 
 CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
@@ -105,12 +106,15 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   auto expected = [&](size_t i) -> uint8_t {
     const uint8_t c = model_.geometricClass(i, transform);
     if (c == kWhite && params_.white_filter &&
-        !ExpectedClassModel::brighterThanNeighbourhood(image, static_cast<int>(i % width), static_cast<int>(i / width))) {
+        !ExpectedClassModel::brighterThanNeighbourhood(image, static_cast<int>(i % width),
+                                                       static_cast<int>(i / width))) {
       return kNotImaged;
     }
     return c;
   };
-  auto colorAt = [&](size_t i, uint8_t out[3]) { image.color(static_cast<int>(i % width), static_cast<int>(i / width), out); };
+  auto colorAt = [&](size_t i, uint8_t out[3]) {
+    image.color(static_cast<int>(i % width), static_cast<int>(i / width), out);
+  };
 
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();

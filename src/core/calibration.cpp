@@ -68,7 +68,8 @@ class MapReader {
     if (!n.isInt()) fail(source_, k, "must be an integer");
     const int value = static_cast<int>(n);
     if (value < lo || value > hi) {
-      fail(source_, k, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], is " + std::to_string(value));
+      fail(source_, k,
+           "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], is " + std::to_string(value));
     }
     return value;
   }
@@ -99,7 +100,8 @@ class MapReader {
 };
 
 std::vector<double> numberSequence(MapReader& reader, const cv::FileNode& n, const std::string& k, size_t size) {
-  if (!n.isSeq() || n.size() != size) fail(reader.source(), k, "must be a list of " + std::to_string(size) + " numbers");
+  if (!n.isSeq() || n.size() != size)
+    fail(reader.source(), k, "must be a list of " + std::to_string(size) + " numbers");
   std::vector<double> values;
   for (size_t i = 0; i < size; ++i) values.push_back(reader.number(n[static_cast<int>(i)], k));
   return values;
@@ -119,7 +121,8 @@ CameraCalibration parseCamera(MapReader camera) {
   c.mirror_radius_px = camera.real("mirror_radius_px", 0.0, 1e5, true);
   const cv::FileNode map = camera.child("elevation_map");
   const std::string map_key = camera.key("elevation_map");
-  if (!map.isSeq() || map.size() < 2) fail(camera.source(), map_key, "must be a list of at least two [r_px, elevation_rad] pairs");
+  if (!map.isSeq() || map.size() < 2)
+    fail(camera.source(), map_key, "must be a list of at least two [r_px, elevation_rad] pairs");
   for (size_t i = 0; i < map.size(); ++i) {
     const std::string entry_key = map_key + "[" + std::to_string(i) + "]";
     const auto pair = numberSequence(camera, map[static_cast<int>(i)], entry_key, 2);
@@ -149,7 +152,8 @@ FieldCalibration parseField(MapReader field) {
     f.penalty_area_width_m = penalty_area.real("width_m", 0.0, 1000.0, true);
     penalty_area.rejectUnknownKeys();
   }
-  if (field.has("penalty_mark_distance_m")) f.penalty_mark_distance_m = field.real("penalty_mark_distance_m", 0.0, 1000.0, true);
+  if (field.has("penalty_mark_distance_m"))
+    f.penalty_mark_distance_m = field.real("penalty_mark_distance_m", 0.0, 1000.0, true);
   {
     MapReader goal = field.map("goal");
     f.goal_width_m = goal.real("width_m", 0.0, 1000.0, true);
@@ -178,7 +182,8 @@ std::string fixParserLine(const std::string& message) {
 Calibration parseCalibration(const std::string& yaml_text, const std::string& source_name) {
   cv::FileStorage storage;
   try {
-    storage.open("%YAML:1.0\n" + yaml_text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+    storage.open("%YAML:1.0\n" + yaml_text,
+                 cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
   } catch (const cv::Exception& e) {
     throw CalibrationError(source_name + ": not valid YAML: " + fixParserLine(e.err));
   }
@@ -223,14 +228,17 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
   if (!(c.elevation_map.front().second < 0)) fail(source, "camera.elevation_map[0]", "must look below the horizon");
 
   const FieldCalibration& f = calibration.field;
-  if (!(2 * f.line_width_m < std::min(f.length_m, f.width_m))) fail(source, "field.line_width_m", "too wide for the field");
+  if (!(2 * f.line_width_m < std::min(f.length_m, f.width_m)))
+    fail(source, "field.line_width_m", "too wide for the field");
   if (!(f.center_circle_radius_m < f.width_m / 2 && f.center_circle_radius_m < f.length_m / 2)) {
     fail(source, "field.center_circle_radius_m", "must fit into the field");
   }
   if (!(f.corner_arc_radius_m < f.width_m / 2)) fail(source, "field.corner_arc_radius_m", "must fit into the field");
   if (!(f.goal_area_width_m < f.width_m)) fail(source, "field.goal_area.width_m", "must be less than field.width_m");
-  if (!(f.goal_area_depth_m < f.length_m / 2)) fail(source, "field.goal_area.depth_m", "must be less than half the length");
-  if (!(f.penalty_area_width_m < f.width_m)) fail(source, "field.penalty_area.width_m", "must be less than field.width_m");
+  if (!(f.goal_area_depth_m < f.length_m / 2))
+    fail(source, "field.goal_area.depth_m", "must be less than half the length");
+  if (!(f.penalty_area_width_m < f.width_m))
+    fail(source, "field.penalty_area.width_m", "must be less than field.width_m");
   if (!(f.penalty_area_depth_m < f.length_m / 2)) {
     fail(source, "field.penalty_area.depth_m", "must be less than half the length");
   }
@@ -238,7 +246,8 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
     fail(source, "field.penalty_mark_distance_m", "must be less than half the length");
   }
   if (!(f.goal_width_m < f.width_m)) fail(source, "field.goal.width_m", "must be less than field.width_m");
-  if (f.yellow_goal_x_sign != 1 && f.yellow_goal_x_sign != -1) fail(source, "field.yellow_goal_x_sign", "must be 1 or -1");
+  if (f.yellow_goal_x_sign != 1 && f.yellow_goal_x_sign != -1)
+    fail(source, "field.yellow_goal_x_sign", "must be 1 or -1");
 }
 
 std::string toYaml(const Calibration& calibration) {

@@ -8,7 +8,7 @@ namespace core {
 
 void ClassCluster::reset(double max_value) {
   mean_ = Eigen::Vector3d::Constant(0.5 * max_value);  // eq. 2
-  sigma_max_ = std::sqrt(3.0) / 2.0 * max_value;        // eq. 3
+  sigma_max_ = std::sqrt(3.0) / 2.0 * max_value;       // eq. 3
   sigma_ = sigma_max_;
   last_samples_ = 0;
   trained_ = false;

@@ -7,7 +7,8 @@
 namespace act_color {
 namespace core {
 
-ColorLut::ColorLut(int bits_per_channel, ColorSpace space) : bits_(bits_per_channel), shift_(8 - bits_per_channel), space_(space) {
+ColorLut::ColorLut(int bits_per_channel, ColorSpace space)
+    : bits_(bits_per_channel), shift_(8 - bits_per_channel), space_(space) {
   if (bits_per_channel < 1 || bits_per_channel > 8) {
     throw std::invalid_argument("lut_bits must be in [1, 8], is " + std::to_string(bits_per_channel));
   }
@@ -26,7 +27,8 @@ std::array<uint32_t, kNumClasses> ColorLut::cellCounts() const {
 
 void ColorLut::assign(const std::vector<uint8_t>& table) {
   if (table.size() != table_.size()) {
-    throw std::invalid_argument("table has " + std::to_string(table.size()) + " cells, expected " + std::to_string(table_.size()));
+    throw std::invalid_argument("table has " + std::to_string(table.size()) + " cells, expected " +
+                                std::to_string(table_.size()));
   }
   table_ = table;
 }

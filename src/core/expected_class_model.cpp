@@ -12,7 +12,7 @@ ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
   for (size_t i = 0; i < ground_range_m_.size(); ++i) {
     const PixelRay& ray = camera_.ray(i);
     ground_range_m_[i] = ray.region == PixelRegion::kFloor ? std::hypot(ray.ground_x_m, ray.ground_y_m)
-                                                            : std::numeric_limits<float>::infinity();
+                                                           : std::numeric_limits<float>::infinity();
   }
 }
 

@@ -29,9 +29,9 @@ bool FieldModel::isLine(double x_m, double y_m) const {
   const double lw = field_.line_width_m;
   const double hl = half_length_m_;
   const double hw = half_width_m_;
-  if (ax > hl || ay > hw) return false;        // margin: no markings
+  if (ax > hl || ay > hw) return false;             // margin: no markings
   if (ay >= hw - lw || ax >= hl - lw) return true;  // side and goal lines
-  if (ax <= lw / 2) return true;                // halfway line
+  if (ax <= lw / 2) return true;                    // halfway line
   const double r = std::hypot(x_m, y_m);
   if (r <= field_.center_circle_radius_m && r >= field_.center_circle_radius_m - lw) return true;
   // Goal and penalty areas: outer edges at the given depth and width.

@@ -7,7 +7,9 @@
 namespace act_color {
 namespace core {
 
-ColorSpace nativeColorSpace(PixelFormat format) { return format == PixelFormat::kUyvy ? ColorSpace::kYuv : ColorSpace::kRgb; }
+ColorSpace nativeColorSpace(PixelFormat format) {
+  return format == PixelFormat::kUyvy ? ColorSpace::kYuv : ColorSpace::kRgb;
+}
 
 bool pixelFormatFromEncoding(const std::string& encoding, PixelFormat* format) {
   if (encoding == "rgb8") {
@@ -36,8 +38,10 @@ const char* encodingName(PixelFormat format) {
 
 ImageView ImageView::fromMat(const cv::Mat& mat, PixelFormat format) {
   const int expected_type = format == PixelFormat::kUyvy ? CV_8UC2 : CV_8UC3;
-  if (mat.type() != expected_type) throw std::invalid_argument(std::string("image type does not fit ") + encodingName(format));
-  if (format == PixelFormat::kUyvy && mat.cols % 2 != 0) throw std::invalid_argument("yuv422 images need an even width");
+  if (mat.type() != expected_type)
+    throw std::invalid_argument(std::string("image type does not fit ") + encodingName(format));
+  if (format == PixelFormat::kUyvy && mat.cols % 2 != 0)
+    throw std::invalid_argument("yuv422 images need an even width");
   return ImageView(mat.data, mat.cols, mat.rows, mat.step, format);
 }
 

@@ -57,7 +57,8 @@ double ClassificationMetrics::fitness(const std::vector<int>& classes) const {
 std::string ClassificationMetrics::report() const {
   std::string out;
   char line[160];
-  std::snprintf(line, sizeof(line), "%-8s %8s %9s %12s %12s\n", "class", "recall", "precision", "truth_px", "predicted_px");
+  std::snprintf(line, sizeof(line), "%-8s %8s %9s %12s %12s\n", "class", "recall", "precision", "truth_px",
+                "predicted_px");
   out += line;
   for (int k = 0; k < kNumClasses; ++k) {
     if (truthCount(k) == 0 && predictedCount(k) == 0) continue;

@@ -27,7 +27,8 @@ double OmniCameraModel::elevationAtRadius(double r_px) const {
 
 double OmniCameraModel::radiusAtElevation(double elevation_rad) const {
   const auto& map = camera_.elevation_map;
-  if (elevation_rad < map.front().second || elevation_rad > map.back().second) return std::numeric_limits<double>::quiet_NaN();
+  if (elevation_rad < map.front().second || elevation_rad > map.back().second)
+    return std::numeric_limits<double>::quiet_NaN();
   for (size_t i = 1; i < map.size(); ++i) {
     if (elevation_rad <= map[i].second) {
       const double f = (elevation_rad - map[i - 1].second) / (map[i].second - map[i - 1].second);

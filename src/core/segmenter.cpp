@@ -44,8 +44,8 @@ void classifyUyvyRow(const uint8_t* in, uint8_t* out, int u0, int u1, const uint
   for (int u = u0; u < u1; ++u) {
     const uint8_t* p = in + 4 * (u >> 1);
     const uint8_t y = p[(u & 1) ? 3 : 1];
-    const uint32_t idx = (static_cast<uint32_t>(y >> shift) << (2 * bits)) | (static_cast<uint32_t>(p[0] >> shift) << bits) |
-                         static_cast<uint32_t>(p[2] >> shift);
+    const uint32_t idx = (static_cast<uint32_t>(y >> shift) << (2 * bits)) |
+                         (static_cast<uint32_t>(p[0] >> shift) << bits) | static_cast<uint32_t>(p[2] >> shift);
     out[u] = table[idx];
   }
 }
@@ -54,11 +54,13 @@ void classifyUyvyRow(const uint8_t* in, uint8_t* out, int u0, int u1, const uint
 
 void Segmenter::classify(const ColorLut& lut, const ImageView& image, cv::Mat& labels) const {
   if (lut.colorSpace() != nativeColorSpace(image.format)) {
-    throw std::invalid_argument(std::string("the table's color space does not fit ") + encodingName(image.format) + " images");
+    throw std::invalid_argument(std::string("the table's color space does not fit ") + encodingName(image.format) +
+                                " images");
   }
   if (!spans_.empty() && (image.width != width_ || image.height != height_)) {
     throw std::invalid_argument("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                " px, the calibration is for " + std::to_string(width_) + "x" + std::to_string(height_));
+                                " px, the calibration is for " + std::to_string(width_) + "x" +
+                                std::to_string(height_));
   }
   labels.create(image.height, image.width, CV_8UC1);
   const uint8_t* table = lut.data();

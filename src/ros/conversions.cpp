@@ -17,7 +17,8 @@ bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::stri
     *error = "empty image";
     return false;
   }
-  if (image.step < bytes_per_pixel * image.width || image.data.size() < static_cast<size_t>(image.step) * image.height) {
+  if (image.step < bytes_per_pixel * image.width ||
+      image.data.size() < static_cast<size_t>(image.step) * image.height) {
     *error = "image data is shorter than step * height";
     return false;
   }
@@ -25,7 +26,8 @@ bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::stri
     *error = "yuv422 image with an odd width";
     return false;
   }
-  *view = core::ImageView(image.data.data(), static_cast<int>(image.width), static_cast<int>(image.height), image.step, format);
+  *view = core::ImageView(image.data.data(), static_cast<int>(image.width), static_cast<int>(image.height), image.step,
+                          format);
   return true;
 }
 
@@ -33,8 +35,8 @@ act_color::ColorLutPtr toMsg(const core::ActTrainer& trainer, const std_msgs::He
   auto msg = boost::make_shared<act_color::ColorLut>();
   const core::ColorLut& lut = trainer.lut();
   msg->header = header;
-  msg->color_space =
-      lut.colorSpace() == core::ColorSpace::kYuv ? act_color::ColorLut::COLOR_SPACE_YUV : act_color::ColorLut::COLOR_SPACE_RGB;
+  msg->color_space = lut.colorSpace() == core::ColorSpace::kYuv ? act_color::ColorLut::COLOR_SPACE_YUV
+                                                                : act_color::ColorLut::COLOR_SPACE_RGB;
   msg->bits_per_channel = static_cast<uint8_t>(lut.bitsPerChannel());
   msg->revision = trainer.revision();
   msg->table = lut.table();
@@ -57,12 +59,14 @@ bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* e
     *error = "bits_per_channel must be in [1, 8]";
     return false;
   }
-  if (msg.color_space != act_color::ColorLut::COLOR_SPACE_RGB && msg.color_space != act_color::ColorLut::COLOR_SPACE_YUV) {
+  if (msg.color_space != act_color::ColorLut::COLOR_SPACE_RGB &&
+      msg.color_space != act_color::ColorLut::COLOR_SPACE_YUV) {
     *error = "unknown color_space " + std::to_string(msg.color_space);
     return false;
   }
-  core::ColorLut out(msg.bits_per_channel,
-               msg.color_space == act_color::ColorLut::COLOR_SPACE_YUV ? core::ColorSpace::kYuv : core::ColorSpace::kRgb);
+  core::ColorLut out(msg.bits_per_channel, msg.color_space == act_color::ColorLut::COLOR_SPACE_YUV
+                                               ? core::ColorSpace::kYuv
+                                               : core::ColorSpace::kRgb);
   if (msg.table.size() != out.size()) {
     *error = "table has " + std::to_string(msg.table.size()) + " cells, expected " + std::to_string(out.size());
     return false;
@@ -103,7 +107,8 @@ sensor_msgs::ImagePtr labelsToMsg(const cv::Mat& labels, const std_msgs::Header&
   msg->step = static_cast<uint32_t>(labels.cols);
   msg->data.resize(static_cast<size_t>(labels.rows) * labels.cols);
   for (int v = 0; v < labels.rows; ++v) {
-    std::copy(labels.ptr<uint8_t>(v), labels.ptr<uint8_t>(v) + labels.cols, msg->data.begin() + static_cast<size_t>(v) * labels.cols);
+    std::copy(labels.ptr<uint8_t>(v), labels.ptr<uint8_t>(v) + labels.cols,
+              msg->data.begin() + static_cast<size_t>(v) * labels.cols);
   }
   return msg;
 }

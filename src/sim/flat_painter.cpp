@@ -7,12 +7,13 @@
 namespace act_color {
 namespace sim {
 
-LabeledFrame paintFlatFrame(const core::ExpectedClassModel& model, const core::Pose2D& pose, double brightness, uint32_t seed) {
-  static const double kColors[core::kNumClasses][3] = {
-      {0, 0, 0}, {45, 140, 55}, {235, 235, 230}, {225, 200, 35}, {35, 70, 205}, {28, 28, 32}, {240, 110, 20}};
+LabeledFrame paintFlatFrame(const core::ExpectedClassModel& model, const core::Pose2D& pose, double brightness,
+                            uint32_t seed) {
+  static const double kColors[core::kNumClasses][3] = {{0, 0, 0},     {45, 140, 55}, {235, 235, 230}, {225, 200, 35},
+                                                       {35, 70, 205}, {28, 28, 32},  {240, 110, 20}};
   // Clutter off the field: some of it close to class colors.
-  static const double kClutter[6][3] = {{120, 110, 100}, {90, 150, 80}, {200, 180, 90}, {70, 90, 160}, {160, 60, 50},
-                                        {60, 55, 50}};
+  static const double kClutter[6][3] = {{120, 110, 100}, {90, 150, 80}, {200, 180, 90},
+                                        {70, 90, 160},   {160, 60, 50}, {60, 55, 50}};
   const core::OmniCameraModel& camera = model.camera();
   LabeledFrame frame;
   frame.rgb.create(camera.height(), camera.width(), CV_8UC3);

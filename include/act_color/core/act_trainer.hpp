@@ -19,16 +19,16 @@ namespace core {
 // Parameters of ACT; defaults are the paper's. validate() throws std::invalid_argument naming
 // the parameter and its allowed range.
 struct ActParams {
-  double eta = 4.0;         // eq. 4, 5
-  double zeta = 2.5;        // add c -> k when |mu_k - c| < zeta * sigma_k (2.3)
-  double xi = 1.35;         // remove c from k when |mu_k - c| > xi * sigma_k (2.4)
-  double sigma_min = 6.0;   // lower bound of sigma_k, channel units (2.2)
-  int cluster_stride = 400; // every n-th pixel updates the clusters (2.2)
-  int add_stride = 400;     // every n-th pixel is added (2.3)
-  int remove_stride = 20;   // every n-th pixel off the field is removed (2.4)
-  int lut_bits = 6;         // bits per channel of the table
-  bool white_filter = true; // eq. 1
-  uint32_t seed = 1;        // random start pixels
+  double eta = 4.0;          // eq. 4, 5
+  double zeta = 2.5;         // add c -> k when |mu_k - c| < zeta * sigma_k (2.3)
+  double xi = 1.35;          // remove c from k when |mu_k - c| > xi * sigma_k (2.4)
+  double sigma_min = 6.0;    // lower bound of sigma_k, channel units (2.2)
+  int cluster_stride = 400;  // every n-th pixel updates the clusters (2.2)
+  int add_stride = 400;      // every n-th pixel is added (2.3)
+  int remove_stride = 20;    // every n-th pixel off the field is removed (2.4)
+  int lut_bits = 6;          // bits per channel of the table
+  bool white_filter = true;  // eq. 1
+  uint32_t seed = 1;         // random start pixels
 
   void validate() const;
 };

@@ -29,7 +29,8 @@ struct ImageView {
   PixelFormat format = PixelFormat::kRgb8;
 
   ImageView() = default;
-  ImageView(const uint8_t* d, int w, int h, size_t s, PixelFormat f) : data(d), width(w), height(h), step(s), format(f) {}
+  ImageView(const uint8_t* d, int w, int h, size_t s, PixelFormat f)
+      : data(d), width(w), height(h), step(s), format(f) {}
   // rgb8/bgr8: CV_8UC3; UYVY: CV_8UC2 (OpenCV's layout for YUV 4:2:2).
   static ImageView fromMat(const cv::Mat& mat, PixelFormat format);
 

@@ -18,7 +18,8 @@ struct LabeledFrame {
 // expects for it (off-field pixels get clutter colors), scaled by `brightness`, plus noise. No
 // shading, no 3-D objects but the goals: a fixture for unit tests and a quick demo; the renderer
 // is the realistic simulator.
-LabeledFrame paintFlatFrame(const core::ExpectedClassModel& model, const core::Pose2D& pose, double brightness, uint32_t seed);
+LabeledFrame paintFlatFrame(const core::ExpectedClassModel& model, const core::Pose2D& pose, double brightness,
+                            uint32_t seed);
 
 }  // namespace sim
 }  // namespace act_color
