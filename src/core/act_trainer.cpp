@@ -1,5 +1,6 @@
 #include "act_color/core/act_trainer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -28,6 +29,7 @@ void ActParams::validate() const {
   requireRange("add_stride", add_stride, 1, 1 << 20);
   requireRange("remove_stride", remove_stride, 1, 1 << 20);
   requireRange("lut_bits", lut_bits, 1, 8);
+  requireRange("add_neighbourhood_cells", add_neighbourhood_cells, 0, 3);
 }
 
 ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
@@ -70,7 +72,47 @@ ClusterParams ActTrainer::clusterParams() const {
   p.eta = params_.eta;
   p.sigma_min = params_.sigma_min;
   p.zeta = params_.zeta;
+  p.seed_from_first_samples = params_.seed_clusters;
   return p;
+}
+
+uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
+  const ClassCluster& cluster = clusters_[k];
+  const Eigen::Vector3d color(c[0], c[1], c[2]);
+  const double radius = params_.zeta * cluster.sigma();
+  if ((cluster.mean() - color).norm() >= radius) return 0;  // 2.3: |mu_k - c| < zeta sigma_k
+  uint32_t changed = 0;
+  const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+  if (lut_.at(cell) != k) {
+    lut_.set(cell, k);
+    ++changed;
+  }
+  const int n = params_.add_neighbourhood_cells;
+  if (n == 0) return changed;
+  const int bits = lut_.bitsPerChannel();
+  const int shift = 8 - bits;
+  const int cells = 1 << bits;
+  const double half = 0.5 * (1 << shift);
+  const int i0 = c[0] >> shift, i1 = c[1] >> shift, i2 = c[2] >> shift;
+  for (int a = std::max(0, i0 - n); a <= std::min(cells - 1, i0 + n); ++a) {
+    for (int b = std::max(0, i1 - n); b <= std::min(cells - 1, i1 + n); ++b) {
+      for (int d = std::max(0, i2 - n); d <= std::min(cells - 1, i2 + n); ++d) {
+        const uint32_t neighbour = (static_cast<uint32_t>(a) << (2 * bits)) | (static_cast<uint32_t>(b) << bits) | d;
+        const uint8_t current = lut_.at(neighbour);
+        if (current == k) continue;
+        const Eigen::Vector3d centre((a << shift) + half, (b << shift) + half, (d << shift) + half);
+        const double distance = (cluster.mean() - centre).norm();
+        if (distance >= radius) continue;
+        if (current != kUnknown && current < kNumClasses) {
+          const ClassCluster& other = clusters_[current];
+          if ((other.mean() - centre).norm() / other.sigma() <= distance / cluster.sigma()) continue;
+        }
+        lut_.set(neighbour, k);
+        ++changed;
+      }
+    }
+  }
+  return changed;
 }
 
 void ActTrainer::checkImage(const ImageView& image) const {
@@ -137,14 +179,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     if (k == kUnknown || k >= kNumClasses) continue;
     uint8_t c[3];
     colorAt(i, c);
-    const ClassCluster& cluster = clusters_[k];
-    if ((cluster.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() < params_.zeta * cluster.sigma()) {
-      const uint32_t cell = lut_.index(c[0], c[1], c[2]);
-      if (lut_.at(cell) != k) {
-        lut_.set(cell, k);
-        ++stats.added[k];
-      }
-    }
+    stats.added[k] += addColor(c, k);
   }
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.

@@ -21,7 +21,9 @@ int ClassCluster::update(const std::vector<Eigen::Vector3f>& colors, const Clust
   Eigen::Vector3d sample_mean = Eigen::Vector3d::Zero();
   for (const auto& c : colors) sample_mean += c.cast<double>();
   sample_mean /= m;
-  const double eta = params.eta;
+  // Seeding (an extension, see ClusterParams) is eq. 4-5 with eta = 0 for the first update.
+  const bool seed = params.seed_from_first_samples && !trained_ && colors.size() >= 2;
+  const double eta = seed ? 0.0 : params.eta;
   mean_ = (eta * mean_ + sample_mean) / (eta + 1.0);  // eq. 4
   if (colors.size() >= 2) {
     double sum_sq = 0.0;

@@ -29,6 +29,13 @@ struct ActParams {
   int lut_bits = 6;          // bits per channel of the table
   bool white_filter = true;  // eq. 1
   uint32_t seed = 1;         // random start pixels
+  // Extensions beyond the paper (0 / false gives the paper's algorithm exactly):
+  // the first update of a cluster takes its colors' own statistics (ClusterParams).
+  bool seed_clusters = true;
+  // An added color also adds the cells within this many cells per channel around it whose
+  // centres lie within zeta * sigma_k, unless they belong to a class whose cluster is nearer
+  // (distance in sigmas). Sparse samples then cover a class's colors in a few cycles.
+  int add_neighbourhood_cells = 1;
 
   void validate() const;
 };
@@ -71,6 +78,8 @@ class ActTrainer {
 
  private:
   ClusterParams clusterParams() const;
+  // 2.3 for one color; returns the number of cells that changed to class k.
+  uint32_t addColor(const uint8_t c[3], uint8_t k);
 
   ExpectedClassModel model_;
   ActParams params_;

@@ -12,6 +12,10 @@ struct ClusterParams {
   double sigma_min = 6.0;    // lower bound of sigma, channel units
   double zeta = 2.5;         // a cluster "includes" colors within zeta * sigma
   double max_value = 255.0;  // C_max
+  // Extension: the first update of an untrained cluster takes the colors' own mean and spread
+  // instead of blending them with eq. 2-3 (whose sigma covers the whole color cube, so that every
+  // outlier of the first cycles would be added). false: the paper's eq. 4-5 from the start.
+  bool seed_from_first_samples = true;
 };
 
 // Mean and standard deviation of the colors of one class, tracked over cycles (eq. 2-5).
@@ -22,7 +26,8 @@ class ClassCluster {
   // eq. 2 and 3: the centre of the color cube, sigma covering all of it.
   void reset(double max_value);
 
-  // One cycle with the colors expected to belong to the class (eq. 4, 5), then sigma_min and the
+  // One cycle with the colors expected to belong to the class (eq. 4, 5; see
+  // ClusterParams::seed_from_first_samples for the first one), then sigma_min and the
   // doubling rule: while the colors' mean lies beyond zeta * sigma of the cluster mean, sigma is
   // doubled (up to its initial value) so that the cluster grows to include them.
   // Returns the number of doublings; does nothing for an empty set.

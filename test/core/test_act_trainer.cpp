@@ -1,0 +1,232 @@
+#include <gtest/gtest.h>
+
+#include "act_color/core/act_trainer.hpp"
+#include "act_color/core/metrics.hpp"
+#include "act_color/core/segmenter.hpp"
+#include "act_color/sim/flat_painter.hpp"
+#include "test_util.hpp"
+
+using namespace act_color::core;
+using act_color::sim::paintFlatFrame;
+
+namespace {
+
+ImageView view(const cv::Mat& rgb) { return ImageView::fromMat(rgb, PixelFormat::kRgb8); }
+
+ClassificationMetrics evaluate(const ActTrainer& trainer, const act_color::sim::LabeledFrame& frame,
+                               const Calibration& cal) {
+  cv::Mat labels;
+  Segmenter(cal.camera).classify(trainer.lut(), view(frame.rgb), labels);
+  ClassificationMetrics m;
+  m.add(labels, frame.labels);
+  return m;
+}
+
+// Number of pixels of each geometric class (eq. 1 not applied).
+std::array<size_t, 256> geometricCounts(const ExpectedClassModel& model, const Pose2D& pose) {
+  std::array<size_t, 256> counts{};
+  const PoseTransform t(pose);
+  for (size_t i = 0; i < 580u * 580u; ++i) ++counts[model.geometricClass(i, t)];
+  return counts;
+}
+
+class ActTrainerTest : public ::testing::Test {
+ protected:
+  Calibration cal = act_color::test::defaultCalibration();
+  ExpectedClassModel model{cal};
+  Pose2D pose{2.0, 1.0, 0.4};
+};
+
+}  // namespace
+
+TEST_F(ActTrainerTest, ParametersAreValidatedByName) {
+  auto error = [](ActParams p) -> std::string {
+    try {
+      p.validate();
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error(ActParams()), "");
+  ActParams p;
+  p.zeta = 0.0;
+  EXPECT_NE(error(p).find("zeta"), std::string::npos);
+  p = ActParams();
+  p.remove_stride = 0;
+  EXPECT_NE(error(p).find("remove_stride"), std::string::npos);
+  p = ActParams();
+  p.lut_bits = 9;
+  EXPECT_NE(error(p).find("lut_bits"), std::string::npos);
+  p = ActParams();
+  p.eta = -1;
+  EXPECT_NE(error(p).find("eta"), std::string::npos);
+  EXPECT_THROW(ActTrainer(cal, p), std::invalid_argument);
+  ActTrainer trainer(cal);
+  EXPECT_THROW(trainer.setParams(p), std::invalid_argument);
+  EXPECT_DOUBLE_EQ(trainer.params().eta, 4.0);  // unchanged
+}
+
+TEST_F(ActTrainerTest, BadInputIsRefusedWithAReason) {
+  ActTrainer trainer(cal);
+  cv::Mat small(100, 100, CV_8UC3, cv::Scalar::all(0));
+  try {
+    trainer.cycle(view(small), pose);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("100x100"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("580x580"), std::string::npos);
+  }
+  cv::Mat img(580, 580, CV_8UC3, cv::Scalar::all(0));
+  EXPECT_THROW(trainer.cycle(view(img), Pose2D{std::nan(""), 0, 0}), std::invalid_argument);
+  EXPECT_EQ(trainer.revision(), 0u);
+  EXPECT_NO_THROW(trainer.cycle(view(img), pose));
+  EXPECT_EQ(trainer.revision(), 1u);
+}
+
+TEST_F(ActTrainerTest, ClusterSamplesEveryNthPixel) {
+  const auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  const auto counts = geometricCounts(model, pose);
+  ActParams p;
+  p.cluster_stride = 1;
+  p.white_filter = false;
+  ActTrainer every(cal, p);
+  const CycleStats all = every.cycle(view(frame.rgb), pose);
+  EXPECT_EQ(all.cluster_samples[kGreen], counts[kGreen]);
+  EXPECT_EQ(all.cluster_samples[kBlack], counts[kBlack]);
+  EXPECT_EQ(all.cluster_samples[kWhite], counts[kWhite]);
+  EXPECT_EQ(all.cluster_samples[kUnknown], 0u);  // unknown has no cluster
+  for (int stride : {400, 97}) {
+    p.cluster_stride = stride;
+    ActTrainer trainer(cal, p);
+    const CycleStats s = trainer.cycle(view(frame.rgb), pose);
+    const double expected = static_cast<double>(counts[kGreen]) / stride;
+    EXPECT_NEAR(s.cluster_samples[kGreen], expected, 0.05 * expected + 3) << "stride " << stride;
+  }
+}
+
+TEST_F(ActTrainerTest, RemovalExaminesEveryTwentiethOffFieldPixel) {
+  const Pose2D near_corner{7.5, 4.5, 0.0};  // much of the view is off the carpet
+  const auto frame = paintFlatFrame(model, near_corner, 1.0, 1);
+  const auto counts = geometricCounts(model, near_corner);
+  ActTrainer trainer(cal);
+  const CycleStats s = trainer.cycle(view(frame.rgb), near_corner);
+  const double expected = counts[kUnknown] / 20.0;
+  EXPECT_NEAR(s.remove_candidates, expected, 0.05 * expected);
+}
+
+TEST_F(ActTrainerTest, WhiteIsTrainedOnlyFromPixelsBrighterThanTheirNeighbourhood) {
+  cv::Mat flat(580, 580, CV_8UC3, cv::Scalar(50, 140, 50));  // invisible lines
+  ActParams p;
+  p.cluster_stride = 1;
+  ActTrainer filtered(cal, p);
+  EXPECT_EQ(filtered.cycle(view(flat), pose).cluster_samples[kWhite], 0u);
+  p.white_filter = false;
+  ActTrainer unfiltered(cal, p);
+  EXPECT_GT(unfiltered.cycle(view(flat), pose).cluster_samples[kWhite], 100u);
+}
+
+TEST_F(ActTrainerTest, AddsOnlyColorsWithinZetaSigma) {
+  auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  // A magenta patch on the carpet, expected green: far outside the green cluster.
+  const PoseTransform t(pose);
+  int patch = 0;
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      if (u % 10 == 0 && frame.labels.at<uint8_t>(v, u) == kGreen && model.geometricClass(v * 580 + u, t) == kGreen) {
+        frame.rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(200, 40, 200);
+        ++patch;
+      }
+    }
+  }
+  ASSERT_GT(patch, 1000);
+  ActTrainer trainer(cal);
+  trainer.bootstrap(view(frame.rgb), pose, 40);
+  EXPECT_EQ(trainer.lut().classOf(45, 140, 55), kGreen);
+  EXPECT_NE(trainer.lut().classOf(200, 40, 200), kGreen);
+  // With a huge zeta the threshold no longer filters: the outlier color gets added.
+  ActParams p;
+  p.zeta = 50.0;
+  ActTrainer loose(cal, p);
+  loose.bootstrap(view(frame.rgb), pose, 40);
+  EXPECT_EQ(loose.lut().classOf(200, 40, 200), kGreen);
+}
+
+TEST_F(ActTrainerTest, RemovesOffFieldColorsBeyondXiSigma) {
+  const Pose2D near_corner{7.5, 4.5, 0.0};
+  auto frame = paintFlatFrame(model, near_corner, 1.0, 1);
+  ActTrainer trainer(cal);
+  trainer.bootstrap(view(frame.rgb), near_corner, 30);
+  const auto& green = trainer.clusters()[kGreen];
+  const Eigen::Vector3d mean = green.mean();
+  // Paint everything off the carpet in one color far from green, and train it as green.
+  const PoseTransform t(near_corner);
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      if (model.geometricClass(v * 580 + u, t) == kUnknown) frame.rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(150, 60, 90);
+    }
+  }
+  ColorLut lut = trainer.lut();
+  lut.set(lut.index(150, 60, 90), kGreen);
+  // ...and a color within xi * sigma of the green mean, also seen off the field.
+  const cv::Vec3b near(static_cast<uint8_t>(mean[0]), static_cast<uint8_t>(mean[1]), static_cast<uint8_t>(mean[2]));
+  for (int v = 0; v < 580; v += 2) {
+    for (int u = 0; u < 580; ++u) {
+      if (model.geometricClass(v * 580 + u, t) == kUnknown) frame.rgb.at<cv::Vec3b>(v, u) = near;
+    }
+  }
+  lut.set(lut.index(near[0], near[1], near[2]), kGreen);
+  trainer.loadTable(lut);
+  const CycleStats s = trainer.cycle(view(frame.rgb), near_corner);
+  EXPECT_GE(s.removed[kGreen], 1u);
+  EXPECT_EQ(trainer.lut().classOf(150, 60, 90), kUnknown);
+  EXPECT_EQ(trainer.lut().classOf(near[0], near[1], near[2]), kGreen);
+  // With a huge xi nothing is removed.
+  ActParams p;
+  p.xi = 50.0;
+  ActTrainer keep(cal, p);
+  keep.loadTable(lut);
+  keep.cycle(view(frame.rgb), near_corner);
+  EXPECT_EQ(keep.lut().classOf(150, 60, 90), kGreen);
+}
+
+TEST_F(ActTrainerTest, LearnsAFrameAndAdaptsToDarkening) {
+  const auto bright = paintFlatFrame(model, pose, 1.0, 1);
+  ActTrainer trainer(cal);
+  trainer.bootstrap(view(bright.rgb), pose, 30);
+  const auto before = evaluate(trainer, bright, cal);
+  for (int k : {kGreen, kWhite, kYellow, kBlack}) {
+    EXPECT_GT(before.recall(k), 0.9) << className(k);
+    EXPECT_GT(before.precision(k), 0.9) << className(k);
+  }
+  // The paper's 50% darkening: the old table fails, a few cycles bring green and white back.
+  const auto dark = paintFlatFrame(model, pose, 0.5, 2);
+  EXPECT_LT(evaluate(trainer, dark, cal).recall(kGreen), 0.5);
+  for (int i = 0; i < 12; ++i) trainer.cycle(view(dark.rgb), pose);
+  const auto after = evaluate(trainer, dark, cal);
+  for (int k : {kGreen, kWhite, kBlack}) EXPECT_GT(after.recall(k), 0.9) << className(k);
+}
+
+TEST_F(ActTrainerTest, SameSeedSameTable) {
+  const auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  ActTrainer a(cal), b(cal);
+  a.bootstrap(view(frame.rgb), pose, 5);
+  b.bootstrap(view(frame.rgb), pose, 5);
+  EXPECT_EQ(a.lut().table(), b.lut().table());
+  ActParams p;
+  p.seed = 99;
+  ActTrainer c(cal, p);
+  c.bootstrap(view(frame.rgb), pose, 5);
+  EXPECT_NE(a.lut().table(), c.lut().table());
+}
+
+TEST_F(ActTrainerTest, ANewColorSpaceStartsAFreshTable) {
+  const auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  ActTrainer trainer(cal);
+  EXPECT_FALSE(trainer.cycle(view(frame.rgb), pose).color_space_changed);
+  EXPECT_EQ(trainer.lut().colorSpace(), ColorSpace::kRgb);
+  const cv::Mat uyvy = rgbToUyvy(frame.rgb);
+  const CycleStats s = trainer.cycle(ImageView::fromMat(uyvy, PixelFormat::kUyvy), pose);
+  EXPECT_TRUE(s.color_space_changed);
+  EXPECT_EQ(trainer.lut().colorSpace(), ColorSpace::kYuv);
+}

@@ -1,0 +1,143 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "act_color/core/calibration.hpp"
+#include "test_util.hpp"
+
+using act_color::core::CalibrationError;
+using act_color::core::parseCalibration;
+using act_color::test::readFile;
+using act_color::test::sourcePath;
+
+namespace {
+
+std::string contractText() { return readFile(sourcePath("test/data/contract_example.yaml")); }
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const size_t pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return pos == std::string::npos ? text : text.replace(pos, from.size(), to);
+}
+
+// Message of the CalibrationError thrown for `text`, or "" if it was accepted.
+std::string errorOf(const std::string& text) {
+  try {
+    parseCalibration(text, "cal.yaml");
+  } catch (const CalibrationError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(Calibration, ContractExampleLoads) {
+  const auto c = act_color::test::contractCalibration();
+  EXPECT_EQ(c.camera.width, 580);
+  EXPECT_EQ(c.camera.height, 580);
+  EXPECT_DOUBLE_EQ(c.camera.center_u, 290.0);
+  EXPECT_EQ(c.camera.bearing_sign, 1);
+  EXPECT_DOUBLE_EQ(c.camera.height_m, 0.75);
+  EXPECT_DOUBLE_EQ(c.camera.chassis_radius_px, 42);
+  ASSERT_EQ(c.camera.elevation_map.size(), 2u);
+  EXPECT_DOUBLE_EQ(c.camera.elevation_map[1].second, 0.20);
+  EXPECT_DOUBLE_EQ(c.field.length_m, 18.0);
+  EXPECT_DOUBLE_EQ(c.field.goal_area_width_m, 3.5);
+  EXPECT_DOUBLE_EQ(c.field.penalty_area_depth_m, 2.25);
+  ASSERT_TRUE(c.field.penalty_mark_distance_m.has_value());
+  EXPECT_DOUBLE_EQ(*c.field.penalty_mark_distance_m, 3.0);
+  EXPECT_DOUBLE_EQ(c.field.goal_height_m, 1.0);
+  EXPECT_EQ(c.field.yellow_goal_x_sign, 1);
+}
+
+TEST(Calibration, DefaultConfigLoads) { EXPECT_NO_THROW(act_color::test::defaultCalibration()); }
+
+TEST(Calibration, PenaltyMarkIsOptional) {
+  const auto c = parseCalibration(replaced(contractText(), "  penalty_mark_distance_m: 3.0", ""), "cal.yaml");
+  EXPECT_FALSE(c.field.penalty_mark_distance_m.has_value());
+}
+
+TEST(Calibration, UnknownKeysAreRejectedByName) {
+  EXPECT_NE(errorOf(contractText() + "extra: 1\n").find("cal.yaml: extra: unknown key"), std::string::npos);
+  EXPECT_NE(
+      errorOf(replaced(contractText(), "  height: 580", "  height: 580\n  focal: 3")).find("camera.focal: unknown key"),
+      std::string::npos);
+  EXPECT_NE(
+      errorOf(replaced(contractText(), "{depth_m: 0.75, width_m: 3.5}", "{depth_m: 0.75, width_m: 3.5, color: 1}"))
+          .find("field.goal_area.color: unknown key"),
+      std::string::npos);
+}
+
+TEST(Calibration, MissingKeysAreRejectedByName) {
+  EXPECT_NE(errorOf(replaced(contractText(), "  width_m: 12.0", "")).find("cal.yaml: field.width_m: missing"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "  height_m: 0.75", "")).find("camera.height_m: missing"),
+            std::string::npos);
+  EXPECT_NE(
+      errorOf(replaced(contractText(), "{width_m: 2.0, height_m: 1.0, depth_m: 0.5}", "{width_m: 2.0, height_m: 1.0}"))
+          .find("field.goal.depth_m: missing"),
+      std::string::npos);
+}
+
+TEST(Calibration, ElevationMapMustIncreaseStrictly) {
+  const std::string decreasing_r =
+      replaced(contractText(), "    - [286.0, 0.20]", "    - [286.0, 0.20]\n    - [280.0, 0.25]");
+  EXPECT_NE(errorOf(decreasing_r).find("camera.elevation_map[2]: r_px must increase strictly"), std::string::npos);
+  const std::string decreasing_e =
+      replaced(contractText(), "    - [286.0, 0.20]", "    - [200.0, 0.10]\n    - [286.0, 0.05]");
+  EXPECT_NE(errorOf(decreasing_e).find("camera.elevation_map[2]: elevation_rad must increase strictly"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "    - [286.0, 0.20]\n", "")).find("camera.elevation_map"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "[286.0, 0.20]", "[286.0]")).find("camera.elevation_map[1]"),
+            std::string::npos);
+}
+
+TEST(Calibration, ValuesAreRangeChecked) {
+  EXPECT_NE(errorOf(replaced(contractText(), "bearing_sign: 1 ", "bearing_sign: 0 "))
+                .find("camera.bearing_sign: must be 1 or -1"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "yellow_goal_x_sign: 1", "yellow_goal_x_sign: 2"))
+                .find("field.yellow_goal_x_sign"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "height_m: 0.75", "height_m: -0.75")).find("camera.height_m: must be in"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "width: 580", "width: 580.5")).find("camera.width: must be an integer"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "center: [290.0, 290.0]", "center: [290.0]")).find("camera.center"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "chassis_radius_px: 42", "chassis_radius_px: 300"))
+                .find("camera.chassis_radius_px"),
+            std::string::npos);
+  EXPECT_NE(
+      errorOf(replaced(contractText(), "length_m: 18.0", "length_m: abc")).find("field.length_m: must be a number"),
+      std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "goal: {width_m: 2.0", "goal: {width_m: 20.0")).find("field.goal.width_m"),
+            std::string::npos);
+}
+
+TEST(Calibration, DuplicateKeysAreRejected) {
+  EXPECT_NE(errorOf(replaced(contractText(), "  height: 580", "  height: 580\n  height: 581"))
+                .find("camera.height: appears twice"),
+            std::string::npos);
+}
+
+TEST(Calibration, MalformedYamlAndMissingFileNameTheFile) {
+  EXPECT_NE(errorOf("camera: [1,\n").find("cal.yaml: not valid YAML"), std::string::npos);
+  EXPECT_NE(errorOf("").find("cal.yaml"), std::string::npos);
+  try {
+    act_color::core::loadCalibration("/nonexistent/cal.yaml");
+    FAIL() << "no error";
+  } catch (const CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/cal.yaml"), std::string::npos);
+  }
+}
+
+TEST(Calibration, YamlRoundTrip) {
+  const auto c = act_color::test::defaultCalibration();
+  const auto d = parseCalibration(act_color::core::toYaml(c), "roundtrip");
+  EXPECT_EQ(act_color::core::toYaml(c), act_color::core::toYaml(d));
+  EXPECT_EQ(c.camera.elevation_map, d.camera.elevation_map);
+  EXPECT_EQ(c.field.penalty_mark_distance_m, d.field.penalty_mark_distance_m);
+}
