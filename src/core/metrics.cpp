@@ -23,6 +23,12 @@ void ClassificationMetrics::add(const cv::Mat& labels, const cv::Mat& truth) {
   }
 }
 
+void ClassificationMetrics::merge(const ClassificationMetrics& other) {
+  for (int t = 0; t < kNumClasses; ++t) {
+    for (int p = 0; p < kNumClasses; ++p) confusion_[t][p] += other.confusion_[t][p];
+  }
+}
+
 uint64_t ClassificationMetrics::truthCount(int k) const {
   uint64_t n = 0;
   for (int p = 0; p < kNumClasses; ++p) n += confusion_[k][p];

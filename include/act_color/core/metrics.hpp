@@ -16,6 +16,8 @@ class ClassificationMetrics {
  public:
   void add(const cv::Mat& labels, const cv::Mat& truth);
   void clear() { confusion_ = {}; }
+  // Adds another's counts (e.g. per-frame metrics into a run's).
+  void merge(const ClassificationMetrics& other);
 
   // confusion()[truth][predicted]
   const std::array<std::array<uint64_t, kNumClasses>, kNumClasses>& confusion() const { return confusion_; }

@@ -1,0 +1,50 @@
+#pragma once
+
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+#include "act_color/core/act_trainer.hpp"
+#include "act_color/core/run_evaluation.hpp"
+
+namespace act_color {
+namespace ros_layer {
+
+// What act_replay does (see README, "act_replay").
+struct ReplayOptions {
+  std::string input_bag;
+  std::string calibration;
+  std::string output_bag;
+  std::string image_topic = "/omni/image_raw";
+  std::string pose_topic = "/localization/pose";
+  std::string truth_topic = "/omni/labels_truth";
+  std::string events_topic = "/scenario/events";
+  core::ActParams params;
+  int bootstrap_cycles = 20;  // cycles on the first image with a pose (paper, section 2)
+  size_t lut_every = 1;       // write /act/color_lut with every n-th frame
+  size_t adapt_frames = 12;   // frames after each event excluded from the "adapted" figures
+  std::string csv_path;       // per-frame recall/precision, when not empty
+  bool progress = true;       // a progress line on stderr every few seconds
+};
+
+struct ReplayResult {
+  size_t images = 0;
+  size_t trained = 0;          // frames with a usable pose
+  size_t without_pose = 0;     // frames before the first pose, or with a NaN pose
+  size_t unusable_images = 0;  // wrong encoding or size: labelled all unknown
+  size_t with_truth = 0;
+  core::RunEvaluation evaluation;
+};
+
+// Thrown for a bag or calibration that cannot be used at all; the message says why.
+class ReplayError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Runs ACT and the segmentation over every image of the input bag, in order, with the pose
+// nearest in time at or before each image; writes /segmentation/labels and /act/color_lut.
+ReplayResult runReplay(const ReplayOptions& options, std::ostream& log);
+
+}  // namespace ros_layer
+}  // namespace act_color

@@ -1,0 +1,119 @@
+// act_replay: runs ACT and the segmentation over a recorded bag, without a ROS master.
+// Usage: see printUsage() and README.md.
+#include <ros/time.h>
+
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/ros/bag_replay.hpp"
+
+namespace {
+
+void printUsage(std::ostream& out) {
+  out << "usage: act_replay --bag IN.bag --calibration CAL.yaml --output OUT.bag [options]\n"
+         "  --image-topic T      images (default /omni/image_raw)\n"
+         "  --pose-topic T       PoseWithCovarianceStamped of base_link in field (default /localization/pose)\n"
+         "  --truth-topic T      mono8 truth labels, optional (default /omni/labels_truth)\n"
+         "  --events-topic T     std_msgs/String events splitting the run (default /scenario/events)\n"
+         "  --seed N             random start pixels (default 1)\n"
+         "  --zeta X --xi X --eta X --sigma-min X\n"
+         "  --cluster-stride N --add-stride N --remove-stride N --lut-bits N\n"
+         "  --paper              the paper's algorithm exactly (no cluster seeding, no neighbourhood additions)\n"
+         "  --bootstrap-cycles N cycles on the first image with a pose (default 20)\n"
+         "  --lut-every N        write /act/color_lut with every n-th frame (default 1)\n"
+         "  --adapt-frames N     frames after each event left out of the *_ad figures (default 12)\n"
+         "  --csv FILE           per-frame recall and precision per class\n"
+         "  --no-progress        no progress lines on stderr\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ros::Time::init();
+  act_color::ros_layer::ReplayOptions options;
+  auto& p = options.params;
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
+        return argv[++i];
+      };
+      auto number = [&]() { return std::stod(value()); };
+      auto integer = [&]() { return std::stoi(value()); };
+      if (arg == "--help" || arg == "-h") {
+        printUsage(std::cout);
+        return 0;
+      } else if (arg == "--bag") {
+        options.input_bag = value();
+      } else if (arg == "--calibration") {
+        options.calibration = value();
+      } else if (arg == "--output") {
+        options.output_bag = value();
+      } else if (arg == "--image-topic") {
+        options.image_topic = value();
+      } else if (arg == "--pose-topic") {
+        options.pose_topic = value();
+      } else if (arg == "--truth-topic") {
+        options.truth_topic = value();
+      } else if (arg == "--events-topic") {
+        options.events_topic = value();
+      } else if (arg == "--seed") {
+        p.seed = static_cast<uint32_t>(std::stoul(value()));
+      } else if (arg == "--zeta") {
+        p.zeta = number();
+      } else if (arg == "--xi") {
+        p.xi = number();
+      } else if (arg == "--eta") {
+        p.eta = number();
+      } else if (arg == "--sigma-min") {
+        p.sigma_min = number();
+      } else if (arg == "--cluster-stride") {
+        p.cluster_stride = integer();
+      } else if (arg == "--add-stride") {
+        p.add_stride = integer();
+      } else if (arg == "--remove-stride") {
+        p.remove_stride = integer();
+      } else if (arg == "--lut-bits") {
+        p.lut_bits = integer();
+      } else if (arg == "--paper") {
+        p.seed_clusters = false;
+        p.add_neighbourhood_cells = 0;
+      } else if (arg == "--bootstrap-cycles") {
+        options.bootstrap_cycles = integer();
+      } else if (arg == "--lut-every") {
+        options.lut_every = static_cast<size_t>(std::stoul(value()));
+      } else if (arg == "--adapt-frames") {
+        options.adapt_frames = static_cast<size_t>(std::stoul(value()));
+      } else if (arg == "--csv") {
+        options.csv_path = value();
+      } else if (arg == "--no-progress") {
+        options.progress = false;
+      } else {
+        throw std::invalid_argument("unknown option " + arg);
+      }
+    }
+    if (options.input_bag.empty() || options.calibration.empty() || options.output_bag.empty()) {
+      throw std::invalid_argument("--bag, --calibration and --output are required");
+    }
+    p.validate();
+  } catch (const std::exception& e) {
+    std::cerr << "act_replay: " << e.what() << "\n";
+    printUsage(std::cerr);
+    return 2;
+  }
+
+  try {
+    const auto result = act_color::ros_layer::runReplay(options, std::cerr);
+    std::cout << "act_replay: " << result.images << " frames from " << options.input_bag << " (" << result.trained
+              << " trained, " << result.without_pose << " without a usable pose, " << result.unusable_images
+              << " unusable images, " << result.with_truth << " with truth); wrote " << options.output_bag << "\n";
+    if (result.with_truth > 0) std::cout << result.evaluation.report();
+    return result.images > result.unusable_images ? 0 : 1;
+  } catch (const std::exception& e) {
+    std::cerr << "act_replay: " << e.what() << "\n";
+    return 1;
+  }
+}
