@@ -83,6 +83,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   if ((cluster.mean() - color).norm() >= radius) return 0;  // 2.3: |mu_k - c| < zeta sigma_k
   uint32_t changed = 0;
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+  if (params_.robust_clusters && claimedByOtherClass(color, lut_.at(cell), k)) return 0;
   if (lut_.at(cell) != k) {
     lut_.set(cell, k);
     ++changed;
@@ -103,16 +104,45 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
         const Eigen::Vector3d centre((a << shift) + half, (b << shift) + half, (d << shift) + half);
         const double distance = (cluster.mean() - centre).norm();
         if (distance >= radius) continue;
-        if (current != kUnknown && current < kNumClasses) {
-          const ClassCluster& other = clusters_[current];
-          if ((other.mean() - centre).norm() / other.sigma() <= distance / cluster.sigma()) continue;
-        }
+        if (claimedByOtherClass(centre, current, k)) continue;
         lut_.set(neighbour, k);
         ++changed;
       }
     }
   }
   return changed;
+}
+
+bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const {
+  if (current == kUnknown || current == k || current >= kNumClasses) return false;
+  const ClassCluster& other = clusters_[current];
+  if (!other.trained()) return false;
+  const ClassCluster& own = clusters_[k];
+  return (other.mean() - color).norm() / other.sigma() <= (own.mean() - color).norm() / own.sigma();
+}
+
+void ActTrainer::applyLightChange(const Eigen::Vector3d& gain) {
+  const ClusterParams cluster_params = clusterParams();
+  for (auto& cluster : clusters_) cluster.applyGain(gain, cluster_params);
+  // Every mapped cell moves to where its color is under the new light; moved cells win over
+  // what was there (stale mappings of the old light), the rest stays.
+  const int bits = lut_.bitsPerChannel();
+  const int shift = 8 - bits;
+  const double half = 0.5 * (1 << shift);
+  warped_.assign(lut_.table().begin(), lut_.table().end());
+  const uint32_t mask = (1u << bits) - 1;
+  for (uint32_t cell = 0; cell < lut_.size(); ++cell) {
+    const uint8_t k = lut_.at(cell);
+    if (k == kUnknown || k >= kNumClasses) continue;
+    uint8_t moved[3];
+    const uint32_t channel_cells[3] = {cell >> (2 * bits), (cell >> bits) & mask, cell & mask};
+    for (int ch = 0; ch < 3; ++ch) {
+      const double value = ((channel_cells[ch] << shift) + half) * gain[ch];
+      moved[ch] = static_cast<uint8_t>(std::clamp(value, 0.0, 255.0));
+    }
+    warped_[lut_.index(moved[0], moved[1], moved[2])] = k;
+  }
+  lut_.assign(warped_);
 }
 
 void ActTrainer::checkImage(const ImageView& image) const {
@@ -168,9 +198,42 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     samples_[k].emplace_back(c[0], c[1], c[2]);
   }
   const ClusterParams cluster_params = clusterParams();
+  if (params_.robust_clusters) {
+    // Colors that firmly belong to another class train neither cluster nor table for k.
+    for (int k = 1; k < kNumClasses; ++k) {
+      auto& s = samples_[k];
+      s.erase(std::remove_if(s.begin(), s.end(),
+                             [&](const Eigen::Vector3f& c) {
+                               const uint8_t current = lut_.classOf(
+                                   static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]), static_cast<uint8_t>(c[2]));
+                               const Eigen::Vector3d color = c.cast<double>();
+                               return claimedByOtherClass(color, current, static_cast<uint8_t>(k)) &&
+                                      (clusters_[current].mean() - color).norm() <
+                                          params_.zeta * clusters_[current].sigma();
+                             }),
+              s.end());
+    }
+  }
+  const ClassCluster& green = clusters_[kGreen];
+  if (params_.light_compensation && green.trained() && samples_[kGreen].size() >= 10) {
+    Eigen::Vector3d green_mean = Eigen::Vector3d::Zero();
+    for (const auto& c : samples_[kGreen]) green_mean += c.cast<double>();
+    green_mean /= static_cast<double>(samples_[kGreen].size());
+    if ((green_mean - green.mean()).norm() > params_.zeta * green.sigma()) {
+      const Eigen::Vector3d gain =
+          green_mean.cwiseMax(1.0).cwiseQuotient(green.mean().cwiseMax(1.0)).cwiseMax(0.1).cwiseMin(10.0);
+      applyLightChange(gain);
+      stats.light_change = true;
+      stats.light_gain = gain.cast<float>();
+    }
+  }
   for (int k = 1; k < kNumClasses; ++k) {
-    stats.doublings += clusters_[k].update(samples_[k], cluster_params);
-    stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
+    if (params_.robust_clusters && k != kGreen) {
+      stats.cluster_samples[k] = clusters_[k].updateFromInliers(samples_[k], cluster_params);
+    } else {
+      stats.doublings += clusters_[k].update(samples_[k], cluster_params);
+      stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
+    }
   }
 
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace act_color {
 namespace core {
@@ -39,6 +40,51 @@ int ClassCluster::update(const std::vector<Eigen::Vector3f>& colors, const Clust
   }
   trained_ = true;
   return doublings;
+}
+
+unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params) {
+  if (!trained_) {
+    if (colors.size() < 2) {
+      last_samples_ = 0;
+      return 0;
+    }
+    std::vector<float> channel(colors.size());
+    Eigen::Vector3d median;
+    for (int c = 0; c < 3; ++c) {
+      for (size_t i = 0; i < colors.size(); ++i) channel[i] = colors[i][c];
+      std::nth_element(channel.begin(), channel.begin() + channel.size() / 2, channel.end());
+      median[c] = channel[channel.size() / 2];
+    }
+    std::vector<double> distance(colors.size());
+    for (size_t i = 0; i < colors.size(); ++i) distance[i] = (colors[i].cast<double>() - median).norm();
+    std::nth_element(distance.begin(), distance.begin() + distance.size() / 2, distance.end());
+    // For normally distributed colors the root mean square distance (eq. 5's sigma) is 1.126
+    // times the median distance (chi distribution, 3 degrees of freedom).
+    mean_ = median;
+    sigma_ = std::max(1.126 * distance[distance.size() / 2], params.sigma_min);
+    last_samples_ = static_cast<unsigned>(colors.size());
+    trained_ = true;
+    return last_samples_;
+  }
+  inliers_.clear();
+  const double radius = params.zeta * sigma_;
+  for (const auto& c : colors) {
+    if ((c.cast<double>() - mean_).norm() < radius) inliers_.push_back(c);
+  }
+  if (inliers_.size() < 2) {
+    last_samples_ = 0;
+    return 0;
+  }
+  ClusterParams no_growth = params;
+  no_growth.zeta = std::numeric_limits<double>::infinity();  // no doubling
+  update(inliers_, no_growth);
+  return last_samples_;
+}
+
+void ClassCluster::applyGain(const Eigen::Vector3d& gain, const ClusterParams& params) {
+  if (!trained_) return;
+  mean_ = mean_.cwiseProduct(gain).cwiseMax(0.0).cwiseMin(params.max_value);
+  sigma_ = std::min(std::max(sigma_ * gain.maxCoeff(), params.sigma_min), sigma_max_);
 }
 
 void ClassCluster::set(const Eigen::Vector3d& mean, double sigma, bool trained) {

@@ -98,7 +98,24 @@ std::string RunEvaluation::report() const {
   }
   std::snprintf(line, sizeof(line), "whole run: %zu frames\n", frame_metrics_.size());
   out += line;
-  classTable(nullptr, overall(), nullptr);
+  const ClassificationMetrics whole = overall();
+  classTable(nullptr, whole, nullptr);
+  out += "confusion of the whole run, pixels (rows: truth, columns: classified as)\n         ";
+  for (int p = 0; p < kNumClasses; ++p) {
+    std::snprintf(line, sizeof(line), " %9s", className(p));
+    out += line;
+  }
+  out += "\n";
+  for (int t = 0; t < kNumClasses; ++t) {
+    if (whole.truthCount(t) == 0) continue;
+    std::snprintf(line, sizeof(line), "  %-7s", className(t));
+    out += line;
+    for (int p = 0; p < kNumClasses; ++p) {
+      std::snprintf(line, sizeof(line), " %9llu", static_cast<unsigned long long>(whole.confusion()[t][p]));
+      out += line;
+    }
+    out += "\n";
+  }
   return out;
 }
 

@@ -36,6 +36,15 @@ struct ActParams {
   // centres lie within zeta * sigma_k, unless they belong to a class whose cluster is nearer
   // (distance in sigmas). Sparse samples then cover a class's colors in a few cycles.
   int add_neighbourhood_cells = 1;
+  // Classes other than green learn only from colors that fit their cluster (ClassCluster::
+  // updateFromInliers), and a color that firmly belongs to another trained class (mapped to it and
+  // within zeta * sigma of it) trains neither cluster nor table for the expected class. Protects
+  // goals and black against robots in the goal region and wrong poses.
+  bool robust_clusters = true;
+  // When green's colors jump beyond zeta * sigma (a global change of light), the per-channel gain
+  // of green's mean is applied to every cluster and to the table, so that all classes follow at
+  // once instead of re-learning from sparse samples.
+  bool light_compensation = true;
 
   void validate() const;
 };
@@ -48,6 +57,8 @@ struct CycleStats {
   uint32_t remove_candidates = 0;                       // off-field pixels examined
   uint32_t doublings = 0;                               // sigma doublings over all clusters
   bool color_space_changed = false;                     // table reset for a new color space
+  bool light_change = false;                            // light compensation applied
+  Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain
 };
 
 // The ACT algorithm (paper, section 2): one cycle per image and pose.
@@ -80,6 +91,11 @@ class ActTrainer {
   ClusterParams clusterParams() const;
   // 2.3 for one color; returns the number of cells that changed to class k.
   uint32_t addColor(const uint8_t c[3], uint8_t k);
+  // True when the color is mapped to a trained class other than k and is nearer to that class's
+  // cluster than to k's, in units of sigma.
+  bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
+  // Light compensation: gains to every cluster, table cells moved by the gains.
+  void applyLightChange(const Eigen::Vector3d& gain);
 
   ExpectedClassModel model_;
   ActParams params_;
@@ -90,6 +106,7 @@ class ActTrainer {
   bool space_known_ = false;
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
+  std::vector<uint8_t> warped_;
 };
 
 }  // namespace core

@@ -38,6 +38,15 @@ class ClassCluster {
   unsigned lastSampleCount() const { return last_samples_; }
   bool trained() const { return trained_; }
 
+  // Extension (ActParams::robust_clusters) for classes whose expected pixels may show something
+  // else (a robot in front of a goal, a wrong pose): an untrained cluster is seeded from the
+  // per-channel median and the median distance; a trained one is updated by eq. 4-5 from the
+  // colors within zeta * sigma only (at least two), without doubling. Returns the inliers used.
+  unsigned updateFromInliers(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
+
+  // A global change of light, modelled as per-channel gains: mean *= gain, sigma *= max gain.
+  void applyGain(const Eigen::Vector3d& gain, const ClusterParams& params);
+
   // For restoring a saved state.
   void set(const Eigen::Vector3d& mean, double sigma, bool trained);
 
@@ -47,6 +56,7 @@ class ClassCluster {
   double sigma_max_ = 0.0;
   unsigned last_samples_ = 0;
   bool trained_ = false;
+  std::vector<Eigen::Vector3f> inliers_;  // scratch
 };
 
 }  // namespace core

@@ -1,0 +1,72 @@
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <utility>
+#include <vector>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/image_view.hpp"
+#include "act_color/core/omni_camera_model.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+namespace core {
+
+// A look-up table owned by someone else (e.g. a shared, immutable ColorLut message): lets the
+// segmentation classify with a table it must not copy.
+struct LutView {
+  const uint8_t* table = nullptr;
+  size_t size = 0;
+  int bits = 6;
+  ColorSpace space = ColorSpace::kRgb;
+};
+
+// Classifies whole images with a borrowed table; the same result as Segmenter::classify with a
+// ColorLut holding the same cells (pixels outside the mirror are kUnknown).
+class LutViewSegmenter {
+ public:
+  explicit LutViewSegmenter(const CameraCalibration& camera);
+  // Throws std::invalid_argument when the table is inconsistent, its color space does not fit the
+  // image or the image size does not fit the camera.
+  void classify(const LutView& lut, const ImageView& image, cv::Mat& labels) const;
+
+ private:
+  int width_;
+  int height_;
+  std::vector<std::pair<int, int>> spans_;  // per row: half-open column span inside the mirror
+};
+
+enum class FeatureType : uint8_t { kLinePoint = 0, kYellowGoal = 1, kBlueGoal = 2, kBall = 3, kObstacle = 4 };
+
+struct Feature {
+  FeatureType type = FeatureType::kLinePoint;
+  float u = 0.f, v = 0.f;                    // pixel of the floor point
+  float centroid_u = 0.f, centroid_v = 0.f;  // centre of the run or blob
+  float base_x_m = 0.f, base_y_m = 0.f;      // floor point in base_link
+  float field_x_m = 0.f, field_y_m = 0.f;    // floor point in field (toField)
+  uint32_t size = 0;
+};
+
+struct FeatureParams {
+  int scan_lines = 180;      // radial scan lines over 360 degrees
+  int max_line_run_px = 12;  // longer white runs are not lines
+  int min_goal_run_px = 3;   // goal and obstacle runs shorter than this are noise
+  int min_obstacle_run_px = 4;
+  int min_ball_pixels = 6;        // orange blobs smaller than this are noise
+  double obstacle_merge_m = 0.5;  // neighbouring scan lines' obstacle feet closer than this merge
+};
+
+// Features of a label image (class ids, the camera's size) by radial scan lines from the chassis
+// to the mirror's rim: the robot's other modules use them (self-localization, ball, obstacles).
+// Only pixels whose ray meets the floor give features. Throws std::invalid_argument when the
+// label image does not fit the camera.
+std::vector<Feature> extractFeatures(const cv::Mat& labels, const OmniCameraModel& camera,
+                                     const FeatureParams& params = FeatureParams());
+
+// Fills field_x_m / field_y_m from base_x_m / base_y_m for the pose of base_link in field.
+void toField(const Pose2D& pose, std::vector<Feature>* features);
+
+}  // namespace core
+}  // namespace act_color
