@@ -1,0 +1,116 @@
+#include "act_color/ros/pose_source.hpp"
+
+#include <geometry_msgs/TransformStamped.h>
+
+#include <sstream>
+
+#include "act_color/ros/conversions.hpp"
+
+namespace act_color {
+namespace ros_conversions {
+namespace {
+// About 3 s of poses at 60 Hz: enough to find the pose of a frame that waited in a queue.
+constexpr size_t kMaxPoses = 200;
+}  // namespace
+
+bool PoseSource::init(ros::NodeHandle& nh, ros::NodeHandle& pnh, const std::string& name, std::string* error) {
+  name_ = name;
+  std::string source = pnh.param<std::string>("pose_source", "topic");
+  max_age_s_ = pnh.param("max_pose_age", 1.0);
+  field_frame_ = pnh.param<std::string>("field_frame", "field");
+  base_frame_ = pnh.param<std::string>("base_frame", "base_link");
+  if (source == "topic") {
+    mode_ = Mode::kTopic;
+    sub_ = nh.subscribe("pose", 20, &PoseSource::onPose, this);
+  } else if (source == "tf") {
+    mode_ = Mode::kTf;
+    tf_buffer_ = std::make_unique<tf2_ros::Buffer>(ros::Duration(10.0));
+    // No own thread: tf messages are handled by the nodelet's callback queue.
+    tf_listener_ = std::make_unique<tf2_ros::TransformListener>(*tf_buffer_, nh, false);
+  } else {
+    *error = "~pose_source must be 'topic' or 'tf', is '" + source + "'";
+    return false;
+  }
+  return true;
+}
+
+void PoseSource::onPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
+  core::Pose2D pose;
+  std::string error;
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++received_;
+  if (!pose2D(msg->pose.pose, &pose, &error)) {
+    ++rejected_;
+    last_rejection_ = "pose stamped " + std::to_string(msg->header.stamp.toSec()) + " rejected: " + error;
+    ROS_ERROR_THROTTLE(5.0, "%s: %s", name_.c_str(), last_rejection_.c_str());
+    return;
+  }
+  if (!msg->header.frame_id.empty() && msg->header.frame_id != field_frame_ &&
+      msg->header.frame_id != "/" + field_frame_) {
+    ++rejected_;
+    last_rejection_ = "pose in frame '" + msg->header.frame_id + "' rejected: expected '" + field_frame_ + "'";
+    ROS_ERROR_THROTTLE(5.0, "%s: %s", name_.c_str(), last_rejection_.c_str());
+    return;
+  }
+  poses_.emplace_back(msg->header.stamp, pose);
+  while (poses_.size() > kMaxPoses) poses_.pop_front();
+}
+
+bool PoseSource::lookup(const ros::Time& stamp, core::Pose2D* pose, std::string* why) {
+  if (mode_ == Mode::kTf) {
+    try {
+      // Zero timeout: never waits for tf.
+      const geometry_msgs::TransformStamped t = tf_buffer_->lookupTransform(field_frame_, base_frame_, stamp);
+      geometry_msgs::Pose p;
+      p.position.x = t.transform.translation.x;
+      p.position.y = t.transform.translation.y;
+      p.position.z = t.transform.translation.z;
+      p.orientation = t.transform.rotation;
+      return pose2D(p, pose, why);
+    } catch (const std::exception& e) {
+      *why = std::string("no tf ") + field_frame_ + " -> " + base_frame_ + " at the image stamp: " + e.what();
+      return false;
+    }
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (poses_.empty()) {
+    *why = "no pose received yet";
+    return false;
+  }
+  const std::pair<ros::Time, core::Pose2D>* best = nullptr;
+  for (const auto& p : poses_) {
+    if (p.first <= stamp && (best == nullptr || p.first >= best->first)) best = &p;
+  }
+  if (best == nullptr) {
+    std::ostringstream s;
+    s << "no pose at or before the image stamp " << stamp.toSec() << " (oldest pose: " << poses_.front().first.toSec()
+      << ")";
+    *why = s.str();
+    return false;
+  }
+  const double age = (stamp - best->first).toSec();
+  if (age > max_age_s_) {
+    std::ostringstream s;
+    s << "the latest pose before the image is " << age << " s old (~max_pose_age " << max_age_s_ << " s)";
+    *why = s.str();
+    return false;
+  }
+  *pose = best->second;
+  return true;
+}
+
+uint64_t PoseSource::received() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return received_;
+}
+uint64_t PoseSource::rejected() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return rejected_;
+}
+std::string PoseSource::lastRejection() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_rejection_;
+}
+
+}  // namespace ros_conversions
+}  // namespace act_color
