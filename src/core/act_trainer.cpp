@@ -30,6 +30,7 @@ void ActParams::validate() const {
   requireRange("remove_stride", remove_stride, 1, 1 << 20);
   requireRange("lut_bits", lut_bits, 1, 8);
   requireRange("add_neighbourhood_cells", add_neighbourhood_cells, 0, 3);
+  requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
 }
 
 ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
@@ -41,6 +42,7 @@ ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
 
 void ActTrainer::reset(ColorSpace space) {
   lut_ = ColorLut(params_.lut_bits, space);
+  confirmed_.assign(lut_.size(), 0);
   for (auto& cluster : clusters_) cluster.reset(255.0);
   space_known_ = true;
 }
@@ -64,6 +66,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
                                 " bits per channel, lut_bits is " + std::to_string(params_.lut_bits));
   }
   lut_ = lut;
+  confirmed_.assign(lut_.size(), 0);
   space_known_ = true;
 }
 
@@ -84,6 +87,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   uint32_t changed = 0;
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
   if (params_.robust_clusters && claimedByOtherClass(color, lut_.at(cell), k)) return 0;
+  confirmed_[cell] = static_cast<uint32_t>(revision_ + 1);
   if (lut_.at(cell) != k) {
     lut_.set(cell, k);
     ++changed;
@@ -111,6 +115,18 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     }
   }
   return changed;
+}
+
+uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
+  if (k != kGreen || !params_.robots_train_black) return k;
+  const ClassCluster& green = clusters_[kGreen];
+  if (!green.trained()) return k;
+  const int lo = std::min({c[0], c[1], c[2]});
+  const int hi = std::max({c[0], c[1], c[2]});
+  const double intensity = c[0] + c[1] + c[2];
+  if (intensity >= 0.6 * green.mean().sum() || hi - lo > 0.35 * hi + 8) return k;
+  const Eigen::Vector3d color(c[0], c[1], c[2]);
+  return (color - green.mean()).norm() > params_.zeta * green.sigma() ? static_cast<uint8_t>(kBlack) : k;
 }
 
 bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const {
@@ -191,11 +207,11 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
   for (size_t i = randomStart(params_.cluster_stride); i < pixels; i += params_.cluster_stride) {
-    const uint8_t k = expected(i);
-    if (k == kUnknown || k >= kNumClasses) continue;
+    const uint8_t expected_k = expected(i);
+    if (expected_k == kUnknown || expected_k >= kNumClasses) continue;
     uint8_t c[3];
     colorAt(i, c);
-    samples_[k].emplace_back(c[0], c[1], c[2]);
+    samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
   }
   const ClusterParams cluster_params = clusterParams();
   if (params_.robust_clusters) {
@@ -242,7 +258,8 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     if (k == kUnknown || k >= kNumClasses) continue;
     uint8_t c[3];
     colorAt(i, c);
-    stats.added[k] += addColor(c, k);
+    const uint8_t trained = trainedClass(k, c);
+    stats.added[trained] += addColor(c, trained);
   }
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
@@ -256,6 +273,10 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     const uint32_t cell = lut_.index(c[0], c[1], c[2]);
     const uint8_t k = lut_.at(cell);
     if (k == kUnknown || k >= kNumClasses) continue;
+    if (confirmed_[cell] != 0 &&
+        revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
+      continue;
+    }
     const ClassCluster& cluster = clusters_[k];
     if ((cluster.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() > params_.xi * cluster.sigma()) {
       lut_.set(cell, kUnknown);

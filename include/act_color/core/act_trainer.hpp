@@ -45,6 +45,15 @@ struct ActParams {
   // of green's mean is applied to every cluster and to the table, so that all classes follow at
   // once instead of re-learning from sparse samples.
   bool light_compensation = true;
+  // A cell confirmed by an in-field sample of its class (within zeta * sigma) in the last n
+  // cycles is not removed for being seen off the field: colors seen on both sides (a dark
+  // poster like a robot) stay with the class that needs them. 0: the paper's removal.
+  int removal_protect_cycles = 10;
+  // Black is the own chassis and the other robots, but the chassis alone is lit differently from
+  // robots elsewhere on the field: a color expected green that is far from green (beyond
+  // zeta * sigma), dark (intensity below 60% of green's) and unsaturated is a robot standing on
+  // the carpet and trains black instead.
+  bool robots_train_black = true;
 
   void validate() const;
 };
@@ -94,6 +103,8 @@ class ActTrainer {
   // True when the color is mapped to a trained class other than k and is nearer to that class's
   // cluster than to k's, in units of sigma.
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
+  // The class a sample expected as k trains (robots_train_black re-routes green to black).
+  uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
   // Light compensation: gains to every cluster, table cells moved by the gains.
   void applyLightChange(const Eigen::Vector3d& gain);
 
@@ -107,6 +118,8 @@ class ActTrainer {
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
   std::vector<uint8_t> warped_;
+  // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.
+  std::vector<uint32_t> confirmed_;
 };
 
 }  // namespace core
