@@ -122,7 +122,7 @@ Scenario driving(ScenarioLength length, const core::Calibration& cal, uint32_t s
   s.description =
       "robot drives a figure-eight across the field among moving robots and the ball; light level and "
       "color temperature vary slowly";
-  const int total = length == ScenarioLength::kSmall ? 48 : 600;
+  const int total = length == ScenarioLength::kSmall ? 48 : 450;
   const double hl = cal.field.length_m / 2, hw = cal.field.width_m / 2;
   std::mt19937 rng(seed);
   const double omega = 0.25;  // rad/s along the figure-eight: about 1.5 m/s
@@ -170,7 +170,7 @@ Scenario spotlights(ScenarioLength length, const core::Calibration& cal, uint32_
   Scenario s;
   s.name = "spotlights";
   s.description = "strong spotlights and hard shadows on a dim field; the robot drives through them";
-  const int total = length == ScenarioLength::kSmall ? 40 : 450;
+  const int total = length == ScenarioLength::kSmall ? 40 : 360;
   const double hl = cal.field.length_m / 2, hw = cal.field.width_m / 2;
   std::mt19937 rng(seed + 17);
   Lighting base;

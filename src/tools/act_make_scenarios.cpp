@@ -17,6 +17,7 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -120,8 +121,8 @@ int main(int argc, char** argv) {
     const auto& known = sim::scenarioNames();
     if (std::find(known.begin(), known.end(), args["--scenario"]) == known.end()) {
       std::string list;
-      for (const auto& n : known) list += " " + n;
-      return badArguments("unknown scenario '" + args["--scenario"] + "' (known: all" + list + ")");
+      for (const auto& n : known) list += n + ", ";
+      return badArguments("unknown scenario '" + args["--scenario"] + "' (known: " + list + "or all)");
     }
     names = {args["--scenario"]};
   }
@@ -172,6 +173,7 @@ int main(int argc, char** argv) {
       rosbag::Bag bag(path, rosbag::bagmode::Write);
       bag.setCompression(compression);
       std::string event_list;
+      std::set<std::string> png_events;
       double render_ms = 0.0;
       for (size_t i = 0; i < scenario.frames.size(); ++i) {
         const sim::ScenarioFrame& frame = scenario.frames[i];
@@ -208,7 +210,10 @@ int main(int argc, char** argv) {
           bag.write("/scenario/events", stamp, msg);
           if (event_list.size() < 200) event_list += (event_list.empty() ? "" : " ") + event + "@" + std::to_string(i);
         }
-        if (!png_dir.empty() && (i == 0 || !frame.events.empty())) {
+        // The first frame, and the first frame of each kind of event.
+        bool first_of_event = false;
+        for (const std::string& event : frame.events) first_of_event |= png_events.insert(event).second;
+        if (!png_dir.empty() && (i == 0 || first_of_event)) {
           const std::string stem = (png_dir / (name + "_" + length_name + "_" + std::to_string(i))).string();
           writePng(stem + "_image.png", rendered.rgb);
           cv::Mat colored;

@@ -117,46 +117,46 @@ TEST_P(ActOnScenarios, PerClassAccuracyOutsideAdaptation) {
 
 INSTANTIATE_TEST_SUITE_P(Small, ActOnScenarios,
                          ::testing::Values(
-                             // Measured with the core of ba5e6b9 (recall/precision):
-                             // green .989/.999 white .953/.875 yellow .925/1.00 blue .939/1.00 black .781/.960
+                             // Measured with the core of f2901a7 (recall/precision):
+                             // green .989/.999 white .951/.878 yellow .925/1.00 blue .939/1.00 black .940/.948
                              Case{"static_darkening",
                                   {{core::kGreen, 0.95, 0.95},
                                    {core::kWhite, 0.90, 0.82},
                                    {core::kYellow, 0.87, 0.95},
                                    {core::kBlue, 0.88, 0.95},
-                                   {core::kBlack, 0.72, 0.90}}},
-                             // green .985/.999 white .981/.832 yellow .905/1.00 blue .916/1.00 black .616/.988
+                                   {core::kBlack, 0.88, 0.89}}},
+                             // green .979/1.00 white .985/.833 yellow .907/1.00 blue .916/1.00 black .900/.958
                              Case{"wrong_pose",
-                                  {{core::kGreen, 0.95, 0.95},
+                                  {{core::kGreen, 0.93, 0.95},
                                    {core::kWhite, 0.93, 0.78},
                                    {core::kYellow, 0.85, 0.95},
                                    {core::kBlue, 0.86, 0.95},
-                                   {core::kBlack, 0.55, 0.93}}},
-                             // green .991/.998 white .840/.975 yellow .826/1.00 blue .911/1.00 black .637/.960
+                                   {core::kBlack, 0.84, 0.90}}},
+                             // green .988/.999 white .842/.974 yellow .826/1.00 blue .911/1.00 black .908/.938
                              Case{"driving",
-                                  {{core::kGreen, 0.95, 0.95},
+                                  {{core::kGreen, 0.94, 0.95},
                                    {core::kWhite, 0.78, 0.92},
                                    {core::kYellow, 0.77, 0.95},
                                    {core::kBlue, 0.85, 0.95},
-                                   {core::kBlack, 0.57, 0.90}}},
-                             // green .995/.989 white .921/.577 yellow .875/1.00 blue .960/1.00 black .668/.876
+                                   {core::kBlack, 0.85, 0.88}}},
+                             // green .996/.989 white .925/.578 yellow .875/1.00 blue .964/1.00 black .884/.804
                              Case{"spotlights",
                                   {{core::kGreen, 0.95, 0.94},
-                                   {core::kWhite, 0.86, 0.52},
+                                   {core::kWhite, 0.87, 0.52},
                                    {core::kYellow, 0.82, 0.95},
-                                   {core::kBlue, 0.90, 0.95},
-                                   {core::kBlack, 0.60, 0.82}}},
-                             // green .988/.998 white .966/.906 yellow .905/1.00 blue .928/1.00 black .614/.987
+                                   {core::kBlue, 0.91, 0.95},
+                                   {core::kBlack, 0.83, 0.75}}},
+                             // green .983/.999 white .966/.901 yellow .906/1.00 blue .928/1.00 black .904/.967
                              Case{"sudden_brightening",
-                                  {{core::kGreen, 0.95, 0.95},
+                                  {{core::kGreen, 0.93, 0.95},
                                    {core::kWhite, 0.91, 0.85},
                                    {core::kYellow, 0.85, 0.95},
                                    {core::kBlue, 0.87, 0.95},
-                                   {core::kBlack, 0.55, 0.93}}}),
+                                   {core::kBlack, 0.85, 0.91}}}),
                          [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.scenario); });
 
 // After the paper's darkening, frames until green and white are back within 0.02 of their final
-// recall (issue 3 asks for 4). Measured with the core of ba5e6b9: green 0 frames, white 14.
+// recall (issue 3 asks for 4). Measured with the core of f2901a7: green 0 frames, white 15.
 TEST(ActRecovery, StaticDarkeningGreenAndWhiteRecover) {
   const RunResult r = runAct("static_darkening");
   for (int k : {core::kGreen, core::kWhite}) {
@@ -169,7 +169,7 @@ TEST(ActRecovery, StaticDarkeningGreenAndWhiteRecover) {
     const int frames = last_bad + 1;
     std::printf("%s: back within 0.02 of its final recall %.3f after %d frames\n", core::className(k), final_recall,
                 frames);
-    EXPECT_LE(frames, k == core::kGreen ? 4 : 16) << core::className(k);
+    EXPECT_LE(frames, k == core::kGreen ? 4 : 18) << core::className(k);
   }
 }
 
