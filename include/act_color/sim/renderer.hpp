@@ -1,8 +1,8 @@
 #pragma once
 
 #include <cstdint>
-#include <opencv2/core.hpp>
 #include <memory>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <vector>
 
@@ -52,27 +52,31 @@ struct Lighting {
   std::vector<Spotlight> spotlights;
   std::vector<Shadow> shadows;
   double exposure = 1.0;
-  double gamma = 1.0 / 2.2;             // output = (exposure * linear) ^ gamma
-  double vignetting = 0.25;             // relative light loss at the mirror's rim
+  double gamma = 1.0 / 2.2;  // output = (exposure * linear) ^ gamma
+  double vignetting = 0.25;  // relative light loss at the mirror's rim
   double blur_sigma_px = 0.7;
-  double noise_sigma = 2.5;             // sensor noise, 8-bit units
+  double noise_sigma = 2.5;  // sensor noise, 8-bit units
   // The paper's darkening (section 3.2): brightness and contrast of the final image to this
   // fraction; 1.0 leaves the image alone, 0.5 is the paper's 50% darkening.
   double brightness_contrast = 1.0;
 };
 
 struct Scene {
-  core::Pose2D robot_pose;                 // true pose of base_link in the field frame
+  core::Pose2D robot_pose;  // true pose of base_link in the field frame
   std::vector<RobotObstacle> robots;
   std::optional<Ball> ball;
   Lighting lighting;
-  uint32_t noise_seed = 1;           // sensor noise of this frame
+  uint32_t noise_seed = 1;  // sensor noise of this frame
 };
 
 // Ray-casts the contract's omnidirectional camera on a 2007-rules MSL field: carpet and lines,
 // 3-D goals (solid colored boxes as in FieldModel), other robots, the ball, and a hall beyond the
 // margin (floor and walls with colored clutter, some of it close to the class colors).
 // Deterministic: the same calibration, hall seed and scene give the same bytes.
+// The hall: walls 4 m beyond the carpet and 4 m high, a ceiling with lamps, boxes and mats on the
+// hall floor and posters/windows on the walls, laid out from `hall_seed`. Truth is the class of the
+// first surface a pixel's ray meets; on the static world it equals
+// ExpectedClassModel::geometricClass exactly (same rays, same floor points, FieldModel::goalHit).
 class Renderer {
  public:
   explicit Renderer(const core::Calibration& calibration, uint32_t hall_seed = 7);
