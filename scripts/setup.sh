@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Sourced by main.sh and test.sh: installs the Debian packages the package needs (only the
-# missing ones) and builds it in a catkin workspace beside the sources (.ws, git-ignored).
+# missing ones) and builds it in a catkin workspace outside the sources (one per checkout, under
+# ~/.cache/act_color; ACT_WS overrides), whose src/act_color links to this checkout.
 # Quiet when everything is already there; the build log is printed only when the build fails.
 
 ACT_ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-ACT_WS=${ACT_WS:-$ACT_ROOT/.ws}
+ACT_WS=${ACT_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/act_color/ws-$(basename "$ACT_ROOT")-$(echo "$ACT_ROOT" | md5sum | cut -c1-8)}
 export ACT_ROOT ACT_WS
 # pyenv's python3 lacks the ROS modules (see shared/ROS_ON_DEBIAN.md).
 export PYENV_VERSION=system

@@ -26,6 +26,12 @@ ClassificationMetrics RunEvaluation::overall() const {
   return all;
 }
 
+ClassificationMetrics RunEvaluation::adapted() const {
+  ClassificationMetrics all;
+  for (const SegmentSummary& seg : segments()) all.merge(seg.adapted);
+  return all;
+}
+
 std::vector<SegmentSummary> RunEvaluation::segments() const {
   std::vector<std::pair<size_t, std::string>> starts;
   if (events_.empty() || events_.front().first != 0) starts.emplace_back(0, "start");
@@ -99,7 +105,8 @@ std::string RunEvaluation::report() const {
   std::snprintf(line, sizeof(line), "whole run: %zu frames\n", frame_metrics_.size());
   out += line;
   const ClassificationMetrics whole = overall();
-  classTable(nullptr, whole, nullptr);
+  const ClassificationMetrics whole_adapted = adapted();
+  classTable(nullptr, whole, &whole_adapted);
   out += "confusion of the whole run, pixels (rows: truth, columns: classified as)\n         ";
   for (int p = 0; p < kNumClasses; ++p) {
     std::snprintf(line, sizeof(line), " %9s", className(p));
@@ -112,6 +119,38 @@ std::string RunEvaluation::report() const {
     out += line;
     for (int p = 0; p < kNumClasses; ++p) {
       std::snprintf(line, sizeof(line), " %9llu", static_cast<unsigned long long>(whole.confusion()[t][p]));
+      out += line;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::string RunEvaluation::brief() const {
+  std::string out;
+  char line[256];
+  const ClassificationMetrics all = overall();
+  const ClassificationMetrics ad = adapted();
+  std::snprintf(line, sizeof(line), "  %-7s %13s %13s   (adapted: from frame %zu after the start and each event)\n", "",
+                "recall", "precision", adapt_frames_);
+  out += line;
+  std::snprintf(line, sizeof(line), "  %-7s %6s %6s %6s %6s\n", "class", "all", "adapt", "all", "adapt");
+  out += line;
+  for (int k : trainableClasses()) {
+    if (all.truthCount(k) == 0) continue;
+    std::snprintf(line, sizeof(line), "  %-7s %6.3f %6.3f %6.3f %6.3f\n", className(k), all.recall(k), ad.recall(k),
+                  all.precision(k), ad.precision(k));
+    out += line;
+  }
+  for (const SegmentSummary& seg : segments()) {
+    if (seg.first_frame == 0) continue;
+    std::snprintf(line, sizeof(line),
+                  "  after '%s' at frame %zu, cycles to settle (within %.2f of final recall):", seg.event.c_str(),
+                  seg.first_frame, settle_tolerance_);
+    out += line;
+    for (int k : trainableClasses()) {
+      if (seg.settle_cycles[k] < 0) continue;
+      std::snprintf(line, sizeof(line), " %s %d", className(k), seg.settle_cycles[k]);
       out += line;
     }
     out += "\n";

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <vector>
 
@@ -26,6 +28,34 @@ struct StampedPose {
   bool valid;
   core::Pose2D pose;
 };
+
+// input | classified | truth (when there is one), written as PNG.
+void writeSideBySide(const std::string& path, const sensor_msgs::Image& image, const cv::Mat& labels,
+                     const cv::Mat* truth) {
+  cv::Mat rgb;  // BGR for imwrite
+  if (image.encoding == "rgb8" || image.encoding == "bgr8") {
+    const cv::Mat in(image.height, image.width, CV_8UC3, const_cast<uint8_t*>(image.data.data()), image.step);
+    if (image.encoding == "rgb8") {
+      cv::cvtColor(in, rgb, cv::COLOR_RGB2BGR);
+    } else {
+      in.copyTo(rgb);
+    }
+  } else {
+    const cv::Mat in(image.height, image.width, CV_8UC2, const_cast<uint8_t*>(image.data.data()), image.step);
+    cv::cvtColor(in, rgb, cv::COLOR_YUV2BGR_UYVY);
+  }
+  std::vector<cv::Mat> panels = {rgb};
+  for (const cv::Mat* l : {&labels, truth}) {
+    if (!l) continue;
+    cv::Mat colored;
+    core::colorizeLabels(*l, colored);
+    cv::cvtColor(colored, colored, cv::COLOR_RGB2BGR);
+    panels.push_back(colored);
+  }
+  cv::Mat out;
+  cv::hconcat(panels, out);
+  cv::imwrite(path, out);
+}
 
 std::string topicList(const rosbag::Bag& bag) {
   rosbag::View all(bag);
@@ -151,14 +181,19 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
       out.write("/act/color_lut", m.getTime(), ros_conversions::toMsg(trainer, header));
     }
     const auto truth_it = truth_by_stamp.find(stamp);
+    cv::Mat truth_mat;
     if (truth_it != truth_by_stamp.end()) {
       const auto truth = truth_it->second.instantiate<sensor_msgs::Image>();
       if (truth->encoding == "mono8" && truth->width == image->width && truth->height == image->height) {
-        const cv::Mat truth_mat(truth->height, truth->width, CV_8UC1, const_cast<uint8_t*>(truth->data.data()),
-                                truth->step);
+        truth_mat = cv::Mat(truth->height, truth->width, CV_8UC1, truth->data.data(), truth->step).clone();
         result.evaluation.addFrame(labels, truth_mat);
         ++result.with_truth;
       }
+    }
+    if (!options.png_dir.empty() && usable && result.images % options.png_every == 0) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "/frame_%05zu.png", result.images);
+      writeSideBySide(options.png_dir + name, *image, labels, truth_mat.empty() ? nullptr : &truth_mat);
     }
     ++result.images;
     const auto now = std::chrono::steady_clock::now();

@@ -2,6 +2,7 @@
 // Usage: see printUsage() and README.md.
 #include <ros/time.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -21,11 +22,15 @@ void printUsage(std::ostream& out) {
          "  --zeta X --xi X --eta X --sigma-min X\n"
          "  --cluster-stride N --add-stride N --remove-stride N --lut-bits N\n"
          "  --paper              the paper's algorithm exactly (no cluster seeding, no neighbourhood additions)\n"
+         "  --neighbourhood-cells N  an added color also adds cells within n cells (default 1)\n"
+         "  --removal-protect-cycles N  cells confirmed in the field within n cycles are not removed (default 10)\n"
          "  --bootstrap-cycles N cycles on the first image with a pose (default 20)\n"
          "  --lut-every N        write /act/color_lut with every n-th frame (default 1)\n"
          "  --adapt-frames N     frames after each event left out of the *_ad figures (default 12)\n"
          "  --csv FILE           per-frame recall and precision per class\n"
-         "  --no-progress        no progress lines on stderr\n";
+         "  --png DIR            input | classified | truth as PNG for every n-th frame (--png-every N, 10)\n"
+         "  --no-progress        no progress lines on stderr\n"
+         "  --brief              a short accuracy summary instead of the full report\n";
 }
 
 }  // namespace
@@ -33,6 +38,7 @@ void printUsage(std::ostream& out) {
 int main(int argc, char** argv) {
   ros::Time::init();
   act_color::ros_layer::ReplayOptions options;
+  bool brief = false;
   auto& p = options.params;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -81,6 +87,10 @@ int main(int argc, char** argv) {
       } else if (arg == "--paper") {
         p.seed_clusters = false;
         p.add_neighbourhood_cells = 0;
+      } else if (arg == "--neighbourhood-cells") {
+        p.add_neighbourhood_cells = integer();
+      } else if (arg == "--removal-protect-cycles") {
+        p.removal_protect_cycles = integer();
       } else if (arg == "--bootstrap-cycles") {
         options.bootstrap_cycles = integer();
       } else if (arg == "--lut-every") {
@@ -89,6 +99,12 @@ int main(int argc, char** argv) {
         options.adapt_frames = static_cast<size_t>(std::stoul(value()));
       } else if (arg == "--csv") {
         options.csv_path = value();
+      } else if (arg == "--png") {
+        options.png_dir = value();
+      } else if (arg == "--png-every") {
+        options.png_every = std::max<size_t>(1, std::stoul(value()));
+      } else if (arg == "--brief") {
+        brief = true;
       } else if (arg == "--no-progress") {
         options.progress = false;
       } else {
@@ -110,7 +126,7 @@ int main(int argc, char** argv) {
     std::cout << "act_replay: " << result.images << " frames from " << options.input_bag << " (" << result.trained
               << " trained, " << result.without_pose << " without a usable pose, " << result.unusable_images
               << " unusable images, " << result.with_truth << " with truth); wrote " << options.output_bag << "\n";
-    if (result.with_truth > 0) std::cout << result.evaluation.report();
+    if (result.with_truth > 0) std::cout << (brief ? result.evaluation.brief() : result.evaluation.report());
     return result.images > result.unusable_images ? 0 : 1;
   } catch (const std::exception& e) {
     std::cerr << "act_replay: " << e.what() << "\n";

@@ -40,8 +40,14 @@ class RunEvaluation {
   ClassificationMetrics overall() const;
   std::vector<SegmentSummary> segments() const;
 
+  // Frames after the first `adapt_frames` of every segment, pooled.
+  ClassificationMetrics adapted() const;
+
   // Human-readable report of all segments and the whole run.
   std::string report() const;
+  // A few lines: the whole run's recall/precision per trainable class (all frames and adapted
+  // frames) and, for each event, the cycles each class needed to settle.
+  std::string brief() const;
   // One CSV row per frame: frame, segment, then recall and precision of each class.
   std::string csv() const;
 

@@ -24,6 +24,8 @@ struct ReplayOptions {
   size_t lut_every = 1;       // write /act/color_lut with every n-th frame
   size_t adapt_frames = 12;   // frames after each event excluded from the "adapted" figures
   std::string csv_path;       // per-frame recall/precision, when not empty
+  std::string png_dir;        // side-by-side PNGs (image | classified | truth), when not empty
+  size_t png_every = 10;      // of every n-th frame
   bool progress = true;       // a progress line on stderr every few seconds
 };
 
