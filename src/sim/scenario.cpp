@@ -102,7 +102,9 @@ Scenario wrongPose(ScenarioLength length, uint32_t seed) {
     const int phase = i % 3;
     f.scene.robot_pose = phase == 0 ? a : phase == 1 ? b : c;
     f.told_pose = phase == 0 ? a : b;
-    if (phase == 2) f.events.push_back("wrong_pose");
+    // One event where the wrong poses begin: a change of condition, not of light, so the run is
+    // one segment from there on (act_replay's adapted figures need segments of some length).
+    if (i == 2) f.events.push_back("wrong_pose");
     placeObjects(&f.scene, staticRobots(), &ball);
     f.scene.noise_seed = noiseSeed(seed, i);
     s.frames.push_back(f);

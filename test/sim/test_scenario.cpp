@@ -72,6 +72,12 @@ TEST(Scenario, WrongPoseTellsAKnownPoseWhileTheRobotStandsElsewhere) {
     const auto& told = f.told_pose;
     const bool marked = std::find(f.events.begin(), f.events.end(), "wrong_pose") != f.events.end();
     if (marked) {
+      EXPECT_EQ(wrong, 0) << "the event marks the first wrong frame only";
+    }
+    if (truth.x_m != told.x_m || truth.y_m != told.y_m || truth.theta_rad != told.theta_rad) {
+      if (wrong == 0) {
+        EXPECT_TRUE(marked);
+      }
       ++wrong;
       EXPECT_NEAR(std::hypot(truth.x_m - told.x_m, truth.y_m - told.y_m), 2.5, 1e-9);
       EXPECT_NEAR(angleDifference(truth.theta_rad, told.theta_rad), 165.0 * M_PI / 180.0, 1e-9);
