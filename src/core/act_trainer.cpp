@@ -137,9 +137,9 @@ bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t curre
   return (other.mean() - color).norm() / other.sigma() <= (own.mean() - color).norm() / own.sigma();
 }
 
-void ActTrainer::applyLightChange(const Eigen::Vector3d& gain) {
+void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot) {
   const ClusterParams cluster_params = clusterParams();
-  for (auto& cluster : clusters_) cluster.applyGain(gain, cluster_params);
+  for (auto& cluster : clusters_) cluster.applyGain(gain, pivot, cluster_params);
   // Every mapped cell moves to where its color is under the new light; moved cells win over
   // what was there (stale mappings of the old light), the rest stays.
   const int bits = lut_.bitsPerChannel();
@@ -153,12 +153,15 @@ void ActTrainer::applyLightChange(const Eigen::Vector3d& gain) {
     uint8_t moved[3];
     const uint32_t channel_cells[3] = {cell >> (2 * bits), (cell >> bits) & mask, cell & mask};
     for (int ch = 0; ch < 3; ++ch) {
-      const double value = ((channel_cells[ch] << shift) + half) * gain[ch];
+      const double value = pivot[ch] + ((channel_cells[ch] << shift) + half - pivot[ch]) * gain[ch];
       moved[ch] = static_cast<uint8_t>(std::clamp(value, 0.0, 255.0));
     }
     warped_[lut_.index(moved[0], moved[1], moved[2])] = k;
   }
   lut_.assign(warped_);
+  // Confirmations were made under the old light: colors of the old light that now show up off the
+  // field must not be protected from removal.
+  std::fill(confirmed_.begin(), confirmed_.end(), 0u);
 }
 
 void ActTrainer::checkImage(const ImageView& image) const {
@@ -236,9 +239,19 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     for (const auto& c : samples_[kGreen]) green_mean += c.cast<double>();
     green_mean /= static_cast<double>(samples_[kGreen].size());
     if ((green_mean - green.mean()).norm() > params_.zeta * green.sigma()) {
-      const Eigen::Vector3d gain =
-          green_mean.cwiseMax(1.0).cwiseQuotient(green.mean().cwiseMax(1.0)).cwiseMax(0.1).cwiseMin(10.0);
-      applyLightChange(gain);
+      // Gains about the channel's zero: 0 for R, G, B and Y, 128 for the chroma channels U and V.
+      const bool yuv = lut_.colorSpace() == ColorSpace::kYuv;
+      const Eigen::Vector3d pivot = yuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
+      Eigen::Vector3d gain;
+      for (int c = 0; c < 3; ++c) {
+        const double from = green.mean()[c] - pivot[c];
+        gain[c] = std::abs(from) >= 8.0 ? (green_mean[c] - pivot[c]) / from : -1.0;
+      }
+      // A channel too close to its pivot tells nothing: it follows the largest reliable gain
+      // (in YUV, chroma scales with luma under a change of light level).
+      const double fallback = std::max(0.1, gain.maxCoeff());
+      for (int c = 0; c < 3; ++c) gain[c] = std::clamp(gain[c] < 0 ? fallback : gain[c], 0.1, 10.0);
+      applyLightChange(gain, pivot);
       stats.light_change = true;
       stats.light_gain = gain.cast<float>();
     }

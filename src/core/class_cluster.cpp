@@ -81,9 +81,9 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
   return last_samples_;
 }
 
-void ClassCluster::applyGain(const Eigen::Vector3d& gain, const ClusterParams& params) {
+void ClassCluster::applyGain(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot, const ClusterParams& params) {
   if (!trained_) return;
-  mean_ = mean_.cwiseProduct(gain).cwiseMax(0.0).cwiseMin(params.max_value);
+  mean_ = (pivot + (mean_ - pivot).cwiseProduct(gain)).cwiseMax(0.0).cwiseMin(params.max_value);
   sigma_ = std::min(std::max(sigma_ * gain.maxCoeff(), params.sigma_min), sigma_max_);
 }
 

@@ -190,21 +190,66 @@ TEST_F(ActTrainerTest, RemovesOffFieldColorsBeyondXiSigma) {
   EXPECT_EQ(keep.lut().classOf(150, 60, 90), kGreen);
 }
 
-TEST_F(ActTrainerTest, LearnsAFrameAndAdaptsToDarkening) {
+TEST_F(ActTrainerTest, LearnsAFrameAndAdaptsToDarkeningInRgbAndYuv) {
   const auto bright = paintFlatFrame(model, pose, 1.0, 1);
-  ActTrainer trainer(cal);
-  trainer.bootstrap(view(bright.rgb), pose, 30);
-  const auto before = evaluate(trainer, bright, cal);
-  for (int k : {kGreen, kWhite, kYellow, kBlack}) {
-    EXPECT_GT(before.recall(k), 0.9) << className(k);
-    EXPECT_GT(before.precision(k), 0.9) << className(k);
+  const auto dark = paintFlatFrame(model, pose, 0.5, 2);  // the paper's 50% darkening
+  for (const PixelFormat format : {PixelFormat::kRgb8, PixelFormat::kUyvy}) {
+    SCOPED_TRACE(encodingName(format));
+    const bool yuv = format == PixelFormat::kUyvy;
+    const cv::Mat bright_image = yuv ? rgbToUyvy(bright.rgb) : bright.rgb;
+    const cv::Mat dark_image = yuv ? rgbToUyvy(dark.rgb) : dark.rgb;
+    auto accuracy = [&](const ActTrainer& trainer, const cv::Mat& image, const cv::Mat& truth) {
+      cv::Mat labels;
+      Segmenter(cal.camera).classify(trainer.lut(), ImageView::fromMat(image, format), labels);
+      ClassificationMetrics m;
+      m.add(labels, truth);
+      return m;
+    };
+    ActTrainer trainer(cal);
+    trainer.bootstrap(ImageView::fromMat(bright_image, format), pose, 30);
+    const auto before = accuracy(trainer, bright_image, bright.labels);
+    for (int k : {kGreen, kWhite, kYellow, kBlack}) {
+      // yuv422 shares chroma between two pixels: thin lines blend with the carpet.
+      EXPECT_GT(before.recall(k), k == kWhite && yuv ? 0.75 : 0.9) << className(k);
+      EXPECT_GT(before.precision(k), 0.9) << className(k);
+    }
+    // The old table fails on the dark image; light compensation brings the classes back at once.
+    EXPECT_LT(accuracy(trainer, dark_image, dark.labels).recall(kGreen), 0.5);
+    const CycleStats first = trainer.cycle(ImageView::fromMat(dark_image, format), pose);
+    EXPECT_TRUE(first.light_change);
+    EXPECT_NEAR(first.light_gain[0], 0.5, 0.05);  // R or Y
+    const auto after_one = accuracy(trainer, dark_image, dark.labels);
+    for (int k : {kGreen, kWhite, kYellow, kBlack}) {
+      EXPECT_GT(after_one.recall(k), k == kWhite && yuv ? 0.7 : 0.85) << className(k);
+    }
+    for (int i = 0; i < 5; ++i) trainer.cycle(ImageView::fromMat(dark_image, format), pose);
+    const auto after = accuracy(trainer, dark_image, dark.labels);
+    for (int k : {kGreen, kWhite, kYellow, kBlack}) {
+      EXPECT_GT(after.recall(k), k == kWhite && yuv ? 0.75 : 0.9) << className(k);
+      EXPECT_GT(after.precision(k), 0.9) << className(k);
+    }
   }
-  // The paper's 50% darkening: the old table fails, a few cycles bring green and white back.
+}
+
+TEST_F(ActTrainerTest, ThePaperAlgorithmAloneAdaptsMoreSlowly) {
+  // All extensions off: eq. 2-5 and 2.3/2.4 as published. Green still recovers within 12 cycles.
+  ActParams paper;
+  paper.seed_clusters = false;
+  paper.add_neighbourhood_cells = 0;
+  paper.robust_clusters = false;
+  paper.light_compensation = false;
+  paper.removal_protect_cycles = 0;
+  paper.robots_train_black = false;
+  const auto bright = paintFlatFrame(model, pose, 1.0, 1);
   const auto dark = paintFlatFrame(model, pose, 0.5, 2);
-  EXPECT_LT(evaluate(trainer, dark, cal).recall(kGreen), 0.5);
-  for (int i = 0; i < 12; ++i) trainer.cycle(view(dark.rgb), pose);
-  const auto after = evaluate(trainer, dark, cal);
-  for (int k : {kGreen, kWhite, kBlack}) EXPECT_GT(after.recall(k), 0.9) << className(k);
+  ActTrainer trainer(cal, paper);
+  trainer.bootstrap(view(bright.rgb), pose, 30);
+  EXPECT_GT(evaluate(trainer, bright, cal).recall(kGreen), 0.9);
+  CycleStats s = trainer.cycle(view(dark.rgb), pose);
+  EXPECT_FALSE(s.light_change);
+  EXPECT_GT(s.doublings, 0u);  // the paper's own mechanism for a change of light
+  for (int i = 0; i < 11; ++i) trainer.cycle(view(dark.rgb), pose);
+  EXPECT_GT(evaluate(trainer, dark, cal).recall(kGreen), 0.9);
 }
 
 TEST_F(ActTrainerTest, SameSeedSameTable) {

@@ -106,7 +106,7 @@ class ActTrainer {
   // The class a sample expected as k trains (robots_train_black re-routes green to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
   // Light compensation: gains to every cluster, table cells moved by the gains.
-  void applyLightChange(const Eigen::Vector3d& gain);
+  void applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot);
 
   ExpectedClassModel model_;
   ActParams params_;

@@ -44,8 +44,9 @@ class ClassCluster {
   // colors within zeta * sigma only (at least two), without doubling. Returns the inliers used.
   unsigned updateFromInliers(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
 
-  // A global change of light, modelled as per-channel gains: mean *= gain, sigma *= max gain.
-  void applyGain(const Eigen::Vector3d& gain, const ClusterParams& params);
+  // A global change of light, modelled as per-channel gains about a pivot (0 for R, G, B and Y;
+  // 128 for U and V): mean = pivot + gain (mean - pivot), sigma *= max gain.
+  void applyGain(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot, const ClusterParams& params);
 
   // For restoring a saved state.
   void set(const Eigen::Vector3d& mean, double sigma, bool trained);
