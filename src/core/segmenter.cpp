@@ -1,6 +1,7 @@
 #include "act_color/core/segmenter.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 namespace act_color {
@@ -37,6 +38,36 @@ void classifyRgbRow(const uint8_t* in, uint8_t* out, int u0, int u1, const uint8
                          static_cast<uint32_t>(p[I2] >> shift);
     out[u] = table[idx];
   }
+}
+
+// The same cells as classifyRgbRow for a table of kBits per channel, four pixels per iteration:
+// each pixel's three bytes are read as one 32-bit word (the fourth byte belongs to the next
+// pixel, so the row's last pixel is done bytewise) and the index is formed with masks.
+template <int kBits, bool kBgr>
+void classifyRgbRowFast(const uint8_t* in, uint8_t* out, int u0, int u1, const uint8_t* table) {
+  constexpr int kShift = 8 - kBits;
+  constexpr uint32_t kMask = (1u << kBits) - 1;
+  auto cell = [](const uint8_t* p) {
+    uint32_t w;
+    std::memcpy(&w, p, sizeof w);
+    const uint32_t first = (w >> kShift) & kMask;         // byte 0
+    const uint32_t second = (w >> (8 + kShift)) & kMask;  // byte 1
+    const uint32_t third = (w >> (16 + kShift)) & kMask;  // byte 2
+    return kBgr ? (third << (2 * kBits)) | (second << kBits) | first
+                : (first << (2 * kBits)) | (second << kBits) | third;
+  };
+  int u = u0;
+  const int last = u1 - 1;  // the last pixel may end the buffer: no 4-byte read there
+  for (; u + 4 <= last; u += 4) {
+    const uint8_t* p = in + 3 * u;
+    const uint32_t a = cell(p), b = cell(p + 3), c = cell(p + 6), d = cell(p + 9);
+    out[u] = table[a];
+    out[u + 1] = table[b];
+    out[u + 2] = table[c];
+    out[u + 3] = table[d];
+  }
+  for (; u < last; ++u) out[u] = table[cell(in + 3 * u)];
+  if (u < u1) classifyRgbRow<kBgr ? 2 : 0, 1, kBgr ? 0 : 2, 3>(in, out, u, u1, table, kBits);
 }
 
 void classifyUyvyRow(const uint8_t* in, uint8_t* out, int u0, int u1, const uint8_t* table, int bits) {
@@ -77,10 +108,18 @@ void Segmenter::classify(const ColorLut& lut, const ImageView& image, cv::Mat& l
     }
     switch (image.format) {
       case PixelFormat::kRgb8:
-        classifyRgbRow<0, 1, 2, 3>(in, out, u0, u1, table, bits);
+        if (bits == 6) {
+          classifyRgbRowFast<6, false>(in, out, u0, u1, table);
+        } else {
+          classifyRgbRow<0, 1, 2, 3>(in, out, u0, u1, table, bits);
+        }
         break;
       case PixelFormat::kBgr8:
-        classifyRgbRow<2, 1, 0, 3>(in, out, u0, u1, table, bits);
+        if (bits == 6) {
+          classifyRgbRowFast<6, true>(in, out, u0, u1, table);
+        } else {
+          classifyRgbRow<2, 1, 0, 3>(in, out, u0, u1, table, bits);
+        }
         break;
       case PixelFormat::kUyvy:
         classifyUyvyRow(in, out, u0, u1, table, bits);
