@@ -277,9 +277,25 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
   const double safe_range = model_.safeCarpetRange(pose);
-  for (size_t i = randomStart(params_.remove_stride); i < pixels; i += params_.remove_stride) {
-    if (model_.surelyOnCarpet(i, safe_range)) continue;
-    if (model_.geometricClass(i, transform) != kUnknown) continue;
+  // The samples lie far apart in memory: fetch the pixel data some samples ahead.
+  const size_t remove_stride = static_cast<size_t>(params_.remove_stride);
+  const size_t ahead = 16 * remove_stride;
+  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
+  const size_t start = randomStart(params_.remove_stride);
+  // Row and column of the sample `ahead` pixels on, kept without divisions.
+  size_t ahead_v = (start + ahead) / width, ahead_u = (start + ahead) % width;
+  for (size_t i = start; i < pixels; i += remove_stride) {
+    model_.prefetchRemoval(i + ahead);
+    if (ahead_v < static_cast<size_t>(image.height)) {
+      __builtin_prefetch(image.data + ahead_v * image.step + ahead_u * bytes_per_pixel);
+    }
+    ahead_u += remove_stride;
+    while (ahead_u >= static_cast<size_t>(width)) {
+      ahead_u -= width;
+      ++ahead_v;
+    }
+    if (!model_.mayBeOffField(i, safe_range)) continue;
+    if (!model_.offField(i, transform)) continue;
     ++stats.remove_candidates;
     uint8_t c[3];
     colorAt(i, c);

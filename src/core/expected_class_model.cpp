@@ -9,11 +9,33 @@ namespace core {
 ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
     : field_(calibration.field), camera_(calibration.camera) {
   ground_range_m_.resize(camera_.rays().size());
+  removal_range_m_.resize(camera_.rays().size());
   for (size_t i = 0; i < ground_range_m_.size(); ++i) {
     const PixelRay& ray = camera_.ray(i);
     ground_range_m_[i] = ray.region == PixelRegion::kFloor ? std::hypot(ray.ground_x_m, ray.ground_y_m)
                                                            : std::numeric_limits<float>::infinity();
+    const bool never_unknown = ray.region == PixelRegion::kNotImaged || ray.region == PixelRegion::kChassis;
+    removal_range_m_[i] = never_unknown ? -std::numeric_limits<float>::infinity() : ground_range_m_[i];
   }
+}
+
+bool ExpectedClassModel::offField(size_t pixel_index, const PoseTransform& pose) const {
+  const PixelRay& ray = camera_.ray(pixel_index);
+  if (ray.region != PixelRegion::kFloor && ray.region != PixelRegion::kAboveHorizon) return false;
+  // The same arithmetic as geometricClass: the same goal test, and off the carpet is kUnknown.
+  const Eigen::Vector3d origin(pose.x_m, pose.y_m, camera_.viewpointHeight());
+  const Eigen::Vector3d dir(pose.cos_theta * ray.dir_x - pose.sin_theta * ray.dir_y,
+                            pose.sin_theta * ray.dir_x + pose.cos_theta * ray.dir_y, ray.dir_z);
+  if (ray.region == PixelRegion::kAboveHorizon) {
+    return field_.goalHit(origin, dir, std::numeric_limits<double>::infinity()) == kUnknown;
+  }
+  double fx, fy;
+  pose.apply(ray.ground_x_m, ray.ground_y_m, &fx, &fy);
+  if (std::abs(fx) >= field_.halfLength() || std::abs(pose.x_m) >= field_.halfLength()) {
+    const double t_floor = camera_.viewpointHeight() / -dir.z();
+    if (field_.goalHit(origin, dir, t_floor) != kUnknown) return false;
+  }
+  return !field_.onCarpet(fx, fy);
 }
 
 uint8_t ExpectedClassModel::geometricClass(size_t pixel_index, const PoseTransform& pose) const {

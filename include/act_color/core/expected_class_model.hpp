@@ -47,6 +47,21 @@ class ExpectedClassModel {
   // Distance from the robot to the nearest carpet edge or goal box (0 when outside the carpet).
   double safeCarpetRange(const Pose2D& pose) const;
 
+  // For the removal step (2.4): false when geometricClass(pixel_index) cannot be kUnknown, decided
+  // from one float per pixel (not imaged, chassis, or a floor point within safe_range_m).
+  bool mayBeOffField(size_t pixel_index, double safe_range_m) const {
+    return !(removal_range_m_[pixel_index] < safe_range_m);
+  }
+  // Hints the cache about a pixel the removal step will look at soon (no effect on results).
+  void prefetchRemoval(size_t pixel_index) const {
+    if (pixel_index >= removal_range_m_.size()) return;
+    __builtin_prefetch(&removal_range_m_[pixel_index]);
+    __builtin_prefetch(&camera_.ray(pixel_index));
+  }
+  // geometricClass(pixel_index, pose) == kUnknown, computed the same way but without telling lines
+  // from carpet.
+  bool offField(size_t pixel_index, const PoseTransform& pose) const;
+
   // eq. 1: the pixel is brighter than the mean of its 5x5 neighbourhood. False within 2 px of
   // the image border.
   static bool brighterThanNeighbourhood(const ImageView& image, int u, int v);
@@ -60,6 +75,9 @@ class ExpectedClassModel {
   OmniCameraModel camera_;
   // Ground distance of each floor pixel's floor point; +inf for others.
   std::vector<float> ground_range_m_;
+  // ground_range_m_, but -inf for pixels that are never kUnknown (not imaged, chassis): the
+  // removal step skips most pixels with this one compact array instead of the 32-byte rays.
+  std::vector<float> removal_range_m_;
 };
 
 }  // namespace core
