@@ -131,13 +131,14 @@ class RosPipeline {
     subs_.push_back(nh_.subscribe<sensor_msgs::Image>("act_benchmark/image", 2, &RosPipeline::onSegImage, this));
     subs_.push_back(nh_.subscribe<act_color::ColorLut>("act_benchmark/color_lut", 2, &RosPipeline::onTable, this));
     subs_.push_back(nh_.subscribe<sensor_msgs::Image>("act_benchmark/labels", 2, &RosPipeline::onLabels, this));
-    // Wait until the intra-process connections exist.
+    // Wait until the intra-process connections exist (the two image subscribers of this process
+    // share one subscription: one subscriber for the publisher).
     const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(5.0);
-    while (ros::WallTime::now() < deadline && (image_pub_.getNumSubscribers() < 2 || lut_pub_.getNumSubscribers() < 1 ||
+    while (ros::WallTime::now() < deadline && (image_pub_.getNumSubscribers() < 1 || lut_pub_.getNumSubscribers() < 1 ||
                                                labels_pub_.getNumSubscribers() < 1)) {
       queue_.callAvailable(ros::WallDuration(0.01));
     }
-    connected_ = image_pub_.getNumSubscribers() >= 2 && lut_pub_.getNumSubscribers() >= 1 &&
+    connected_ = image_pub_.getNumSubscribers() >= 1 && lut_pub_.getNumSubscribers() >= 1 &&
                  labels_pub_.getNumSubscribers() >= 1;
   }
   bool connected() const { return connected_; }

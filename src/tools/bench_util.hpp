@@ -93,8 +93,8 @@ class CmvisionClassifier {
 };
 
 // What a team without a table would write: one cv::inRange per class over the whole image; the
-// first class in the list wins where boxes overlap (later classes only where still unknown would
-// need one more pass, so later ones overwrite and the list is applied in reverse).
+// first class in the list wins where boxes overlap, as in CMVision (the boxes are applied in reverse
+// order, each overwriting the ones before).
 class InRangeClassifier {
  public:
   explicit InRangeClassifier(const std::vector<ColorBox>& boxes) : boxes_(boxes) {}
@@ -162,6 +162,7 @@ struct Series {
 };
 
 inline std::string formatTick(double v) {
+  if (std::abs(v) < 1e-9) v = 0.0;  // no "-0"
   char buf[32];
   if (std::abs(v) >= 100 || v == std::round(v)) {
     std::snprintf(buf, sizeof buf, "%.0f", v);
