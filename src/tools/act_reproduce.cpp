@@ -227,8 +227,8 @@ void fig23(const core::Calibration& cal, const sim::Renderer& renderer, const st
           << "Trained 20 cycles on the first normal frame plus " << before
           << " normal frames, then darkened frames (brightness and contrast 50%); each frame is trained on and "
              "then classified with the table (the contract's rule). Settle: cycles after the drop until the "
-             "class's per-frame recall stays within 0.02 of its final value (mean over the last quarter), as "
-             "act_replay --brief reports it.\n\n";
+             "class's per-frame recall stays within 0.02 of its final value (mean over the last quarter), both "
+             "ways (core::RunEvaluation, act_replay --brief, only counts frames below it).\n\n";
   summary << "| mode | table | green | white | yellow | blue | black | settle green/white | settle all (max) | "
              "final recall green/white/yellow/blue/black |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Mode& mode : modes()) {
@@ -264,7 +264,7 @@ void fig23(const core::Calibration& cal, const sim::Renderer& renderer, const st
         static_series[k].y.push_back(ms.recall(k));
       }
     }
-    // Settle cycles and final recall from per-frame recall (RunEvaluation's definition).
+    // Settle cycles and final recall from per-frame recall (stricter than RunEvaluation: both ways).
     auto settle = [&](const tools::Series& se, double* final_recall) {
       const size_t first = before;  // index of cycle 1
       const size_t n = se.y.size() - first;
