@@ -119,12 +119,8 @@ std::vector<Feature> extractFeatures(const cv::Mat& labels, const OmniCameraMode
   std::vector<Feature> obstacles;
   auto flushObstacles = [&]() {
     if (obstacle_group.empty()) return;
-    // The nearest foot of the group, its size the number of scan lines.
-    auto nearest =
-        std::min_element(obstacle_group.begin(), obstacle_group.end(), [](const Feature& a, const Feature& b) {
-          return std::hypot(a.base_x_m, a.base_y_m) < std::hypot(b.base_x_m, b.base_y_m);
-        });
-    Feature f = *nearest;
+    // The foot on the group's middle scan line: the obstacle's centre bearing.
+    Feature f = obstacle_group[obstacle_group.size() / 2];
     double cu = 0, cv = 0;
     for (const Feature& g : obstacle_group) {
       cu += g.centroid_u;

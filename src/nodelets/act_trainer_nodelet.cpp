@@ -40,6 +40,7 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool configure(std::string* error);
   void onImage(const sensor_msgs::ImageConstPtr& msg);
   void processImage(const sensor_msgs::ImageConstPtr& msg);
+  void trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_hold);
   void publishClassified(const core::ImageView& view, const std_msgs::Header& header);
   void onReconfigure(ActTrainerConfig& config, uint32_t level);
   bool onSaveLut(FilePath::Request& req, FilePath::Response& res);
@@ -68,10 +69,14 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool params_changed_ = false;
   std::optional<core::Pose2D> initial_pose_;
   int bootstrap_cycles_ = 20;
+  bool bootstrap_at_first_pose_ = false;
   bool has_table_ = false;  // bootstrapped, loaded or trained at least once
   std::string lut_file_;
   bool debug_addresses_ = false;
   cv::Mat labels_, classified_;
+  // An image whose pose had not come yet (pose and image of one instant on two connections):
+  // trained when the next image comes, before it.
+  sensor_msgs::ImageConstPtr held_image_;
   // Statistics for diagnostics.
   uint64_t images_ = 0, cycles_ = 0, skipped_ = 0, rejected_ = 0;
   double last_cycle_ms_ = 0.0, max_cycle_ms_ = 0.0, sum_cycle_ms_ = 0.0;
@@ -145,6 +150,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
     initial_pose_ = p;
   }
   bootstrap_cycles_ = pnh_.param("bootstrap_cycles", 20);
+  bootstrap_at_first_pose_ = pnh_.param("bootstrap_at_first_pose", false);
   if (bootstrap_cycles_ < 1 || bootstrap_cycles_ > 1000) {
     *error = "~bootstrap_cycles must be in [1, 1000], is " + std::to_string(bootstrap_cycles_);
     return false;
@@ -189,7 +195,10 @@ bool ActTrainerNodelet::configure(std::string* error) {
   NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s", calibration_path.c_str(),
                calibration.camera.width, calibration.camera.height,
                pose_source_.mode() == ros_conversions::PoseSource::Mode::kTf ? "tf" : "topic",
-               has_table_ ? "loaded" : (initial_pose_ ? "bootstrap at ~initial_pose" : "none (trained online)"));
+               has_table_                 ? "loaded"
+               : initial_pose_            ? "bootstrap at ~initial_pose"
+               : bootstrap_at_first_pose_ ? "bootstrap at the first localization pose"
+                                          : "none (trained online)");
   return true;
 }
 
@@ -207,7 +216,15 @@ void ActTrainerNodelet::processImage(const sensor_msgs::ImageConstPtr& msg) {
   ++images_;
   arrivals_.push_back(ros::WallTime::now());
   while (arrivals_.size() > 2 && (arrivals_.back() - arrivals_.front()).toSec() > 5.0) arrivals_.pop_front();
+  if (held_image_) {
+    const sensor_msgs::ImageConstPtr held = held_image_;
+    held_image_.reset();
+    trainOn(held, false);
+  }
+  trainOn(msg, pose_source_.mode() == ros_conversions::PoseSource::Mode::kTopic);
+}
 
+void ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_hold) {
   core::ImageView view;
   std::string error;
   // A view of the shared message: no copy of the image.
@@ -230,24 +247,29 @@ void ActTrainerNodelet::processImage(const sensor_msgs::ImageConstPtr& msg) {
 
   const auto start = std::chrono::steady_clock::now();
   bool trained = false;
-  if (!has_table_ && initial_pose_) {
+  core::Pose2D pose;
+  std::string why;
+  const bool have_pose = pose_source_.lookup(msg->header.stamp, &pose, &why);
+  if (!has_table_ && (initial_pose_ || (bootstrap_at_first_pose_ && have_pose))) {
     // The start-up table (paper, section 2): the first image at a known pose.
-    trainer_->bootstrap(view, *initial_pose_, bootstrap_cycles_);
-    NODELET_INFO(
-        "start-up table trained with %d cycles on the image stamped %.3f at the initial pose (%.2f, %.2f, %.2f)",
-        bootstrap_cycles_, msg->header.stamp.toSec(), initial_pose_->x_m, initial_pose_->y_m, initial_pose_->theta_rad);
+    const core::Pose2D start = initial_pose_ ? *initial_pose_ : pose;
+    trainer_->bootstrap(view, start, bootstrap_cycles_);
+    NODELET_INFO("start-up table trained with %d cycles on the image stamped %.3f at the %s pose (%.2f, %.2f, %.2f)",
+                 bootstrap_cycles_, msg->header.stamp.toSec(), initial_pose_ ? "initial" : "first localization",
+                 start.x_m, start.y_m, start.theta_rad);
     trained = true;
+  } else if (have_pose) {
+    last_stats_ = trainer_->cycle(view, pose);
+    trained = true;
+  } else if (may_hold) {
+    NODELET_WARN_THROTTLE(5.0, "image stamped %.3f: %s; waiting for the next image", msg->header.stamp.toSec(),
+                          why.c_str());
+    held_image_ = msg;
+    return;
   } else {
-    core::Pose2D pose;
-    std::string why;
-    if (pose_source_.lookup(msg->header.stamp, &pose, &why)) {
-      last_stats_ = trainer_->cycle(view, pose);
-      trained = true;
-    } else {
-      ++skipped_;
-      last_skip_reason_ = why;
-      NODELET_WARN_THROTTLE(5.0, "no training on the image stamped %.3f: %s", msg->header.stamp.toSec(), why.c_str());
-    }
+    ++skipped_;
+    last_skip_reason_ = why;
+    NODELET_WARN_THROTTLE(5.0, "no training on the image stamped %.3f: %s", msg->header.stamp.toSec(), why.c_str());
   }
   if (trained) {
     has_table_ = true;

@@ -44,6 +44,7 @@ class SimulatedCameraNodelet : public nodelet::Nodelet {
   double light_amplitude_ = 0.3;
   double light_period_s_ = 20.0;
   double start_delay_s_ = 0.0;
+  int wait_image_subscribers_ = 0, wait_truth_subscribers_ = 0;
   std::string field_frame_, base_frame_;
   std::atomic<bool> running_{false};
   std::thread thread_;
@@ -69,6 +70,8 @@ void SimulatedCameraNodelet::onInit() {
     light_amplitude_ = pnh.param("light_amplitude", 0.3);
     light_period_s_ = pnh.param("light_period", 20.0);
     start_delay_s_ = pnh.param("start_delay", 0.0);
+    wait_image_subscribers_ = pnh.param("wait_for_image_subscribers", 0);
+    wait_truth_subscribers_ = pnh.param("wait_for_truth_subscribers", 0);
     if (!(light_amplitude_ >= 0.0 && light_amplitude_ < 1.0) || !(light_period_s_ > 0.0))
       throw std::invalid_argument("~light_amplitude must be in [0, 1) and ~light_period > 0");
     field_frame_ = pnh.param<std::string>("field_frame", "field");
@@ -107,22 +110,32 @@ void SimulatedCameraNodelet::run() {
   try {
     const sim::Renderer renderer(calibration_);
     const ros::WallTime start = ros::WallTime::now();
-    while (running_ && (ros::WallTime::now() - start).toSec() < start_delay_s_) ros::WallDuration(0.01).sleep();
+    // Starts after ~start_delay and once the expected subscribers are connected, so that no one
+    // misses the first frame.
+    while (running_ && ros::ok() &&
+           ((ros::WallTime::now() - start).toSec() < start_delay_s_ ||
+            static_cast<int>(image_pub_.getNumSubscribers()) < wait_image_subscribers_ ||
+            static_cast<int>(truth_pub_.getNumSubscribers()) < wait_truth_subscribers_)) {
+      ros::WallDuration(0.01).sleep();
+    }
     ros::WallRate rate(rate_hz_);
     const ros::WallTime t0 = ros::WallTime::now();
     size_t index = 0;
     int published = 0;
+    uint32_t loops = 0;
     while (running_ && ros::ok()) {
       if (index >= scenario_.frames.size()) {
         if (!loop_) break;
         index = 0;
+        ++loops;
       }
       if (max_frames_ > 0 && published >= max_frames_) break;
       sim::ScenarioFrame frame = scenario_.frames[index++];
       // Light changing over time on top of the scenario's own.
       const double t = (ros::WallTime::now() - t0).toSec();
       frame.scene.lighting.level *= 1.0 + light_amplitude_ * std::sin(2.0 * M_PI * t / light_period_s_);
-      frame.scene.noise_seed += static_cast<uint32_t>(published);
+      // The first pass is the scenario as act_make_scenarios writes it; later passes get new noise.
+      frame.scene.noise_seed += loops * 1000003u;
       const sim::LabeledFrame rendered = renderer.render(frame.scene);
 
       std_msgs::Header header;
