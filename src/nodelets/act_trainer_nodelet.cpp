@@ -133,6 +133,13 @@ bool ActTrainerNodelet::configure(std::string* error) {
   params.lut_bits = pnh_.param("lut_bits", params.lut_bits);
   params.white_filter = pnh_.param("white_filter", params.white_filter);
   params.seed = static_cast<uint32_t>(pnh_.param("seed", static_cast<int>(params.seed)));
+  // Extensions beyond the paper (README, "The algorithm, and beyond the paper").
+  params.seed_clusters = pnh_.param("seed_clusters", params.seed_clusters);
+  params.add_neighbourhood_cells = pnh_.param("add_neighbourhood_cells", params.add_neighbourhood_cells);
+  params.robust_clusters = pnh_.param("robust_clusters", params.robust_clusters);
+  params.light_compensation = pnh_.param("light_compensation", params.light_compensation);
+  params.removal_protect_cycles = pnh_.param("removal_protect_cycles", params.removal_protect_cycles);
+  params.robots_train_black = pnh_.param("robots_train_black", params.robots_train_black);
   try {
     params.validate();
   } catch (const std::exception& e) {
