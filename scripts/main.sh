@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # The main job: the whole pipeline on the package's own simulated omnidirectional camera.
-# Renders the scenario bags (sudden darkening, wrong pose, driving under changing light,
+# First the live demo (launch/demo.launch, headless): the simulated camera publishes at 30 Hz
+# with changing light, the ACT trainer and the segmentation nodelets run in one manager, and the
+# accuracy against the simulator's truth is printed every 2 s (ACT_DEMO_SECONDS, default 30).
+# Then it renders the scenario bags (sudden darkening, wrong pose, driving under changing light,
 # spotlights and shadows, sudden brightening), runs ACT and the segmentation over each with
 # act_replay, and prints per-class recall/precision and the cycles each class needed after every
 # light change. Installs what is missing and builds first.
@@ -17,6 +20,26 @@ esac
 act_install_deps
 act_build
 act_source_workspace
+
+demo_seconds=${ACT_DEMO_SECONDS:-30}
+echo "act_color: live demo, $demo_seconds s: simulated camera -> ACT trainer -> segmentation (one nodelet manager)"
+demo_log="$ACT_WS/demo.log"
+set +e
+(cd "$ACT_WS" && timeout -s INT "$demo_seconds" roslaunch act_color demo.launch scenario:=driving >"$demo_log" 2>&1)
+demo_status=$?
+set -e
+# 124: stopped by the timeout, as intended.
+if [ "$demo_status" -ne 124 ] && [ "$demo_status" -ne 0 ]; then
+  tail -n 40 "$demo_log"
+  echo "act_color: the demo failed (exit $demo_status, log: $demo_log)" >&2
+  exit 1
+fi
+sed -e 's/\x1b\[[0-9;]*m//g' "$demo_log" | grep -E "accuracy( over|:)" | sed -e 's/^\[ INFO\] \[[0-9.]*\]: /  /'
+if ! grep -q "accuracy over" "$demo_log"; then
+  echo "act_color: the demo printed no accuracy (log: $demo_log)" >&2
+  exit 1
+fi
+echo
 
 calibration="$ACT_ROOT/config/calibration/msl_2007_580.yaml"
 scenarios="$ACT_WS/scenarios/$length"
