@@ -6,6 +6,34 @@
 
 namespace act_color {
 namespace core {
+namespace {
+
+// Relative margin of the squared-distance pre-checks below: far larger than the rounding of
+// a * a + b * b and of std::hypot (a few ulp), far smaller than any field dimension.
+constexpr double kHypotMargin = 1e-9;
+
+// std::hypot(a, b) <= hi, calling std::hypot only when a * a + b * b lies near hi * hi.
+bool hypotAtMost(double a, double b, double hi) {
+  const double s = a * a + b * b;
+  const double outer = hi * (1 + kHypotMargin);
+  if (hi >= 0 && s > outer * outer) return false;  // surely beyond hi (also for a * a overflowing)
+  const double inner = hi * (1 - kHypotMargin);
+  if (hi > 0 && s < inner * inner) return true;  // surely within hi
+  return std::hypot(a, b) <= hi;
+}
+
+// lo <= std::hypot(a, b) <= hi, calling std::hypot only when a * a + b * b lies near a bound.
+bool hypotWithin(double a, double b, double lo, double hi) {
+  const double s = a * a + b * b;
+  const double outer = hi * (1 + kHypotMargin);
+  if (hi >= 0 && s > outer * outer) return false;
+  const double inner = lo * (1 - kHypotMargin);
+  if (lo > 0 && s < inner * inner) return false;
+  const double r = std::hypot(a, b);
+  return r <= hi && r >= lo;
+}
+
+}  // namespace
 
 FieldModel::FieldModel(const FieldCalibration& field)
     : field_(field),
@@ -32,8 +60,7 @@ bool FieldModel::isLine(double x_m, double y_m) const {
   if (ax > hl || ay > hw) return false;             // margin: no markings
   if (ay >= hw - lw || ax >= hl - lw) return true;  // side and goal lines
   if (ax <= lw / 2) return true;                    // halfway line
-  const double r = std::hypot(x_m, y_m);
-  if (r <= field_.center_circle_radius_m && r >= field_.center_circle_radius_m - lw) return true;
+  if (hypotWithin(x_m, y_m, field_.center_circle_radius_m - lw, field_.center_circle_radius_m)) return true;
   // Goal and penalty areas: outer edges at the given depth and width.
   for (const auto& [depth, width] : {std::make_pair(field_.goal_area_depth_m, field_.goal_area_width_m),
                                      std::make_pair(field_.penalty_area_depth_m, field_.penalty_area_width_m)}) {
@@ -41,10 +68,9 @@ bool FieldModel::isLine(double x_m, double y_m) const {
     if (ay <= width / 2 && ax >= x_inner && ax <= x_inner + lw) return true;
     if (ax >= x_inner && ay <= width / 2 && ay >= width / 2 - lw) return true;
   }
-  const double corner = std::hypot(hl - ax, hw - ay);
-  if (corner <= field_.corner_arc_radius_m && corner >= field_.corner_arc_radius_m - lw) return true;
+  if (hypotWithin(hl - ax, hw - ay, field_.corner_arc_radius_m - lw, field_.corner_arc_radius_m)) return true;
   if (field_.penalty_mark_distance_m) {
-    if (std::hypot(ax - (hl - *field_.penalty_mark_distance_m), y_m) <= lw / 2) return true;
+    if (hypotAtMost(ax - (hl - *field_.penalty_mark_distance_m), y_m, lw / 2)) return true;
   }
   return false;
 }
