@@ -84,7 +84,15 @@ void classifyUyvyRow(const uint8_t* in, uint8_t* out, int u0, int u1, const uint
 }  // namespace
 
 void Segmenter::classify(const ColorLut& lut, const ImageView& image, cv::Mat& labels) const {
-  if (lut.colorSpace() != nativeColorSpace(image.format)) {
+  classify(LutView{lut.data(), lut.size(), lut.bitsPerChannel(), lut.colorSpace()}, image, labels);
+}
+
+void Segmenter::classify(const LutView& lut, const ImageView& image, cv::Mat& labels) const {
+  if (lut.table == nullptr || lut.bits < 1 || lut.bits > 8 || lut.size != (size_t{1} << (3 * lut.bits))) {
+    throw std::invalid_argument("the color table is inconsistent (" + std::to_string(lut.size) + " cells for " +
+                                std::to_string(lut.bits) + " bits per channel)");
+  }
+  if (lut.space != nativeColorSpace(image.format)) {
     throw std::invalid_argument(std::string("the table's color space does not fit ") + encodingName(image.format) +
                                 " images");
   }
@@ -94,8 +102,8 @@ void Segmenter::classify(const ColorLut& lut, const ImageView& image, cv::Mat& l
                                 std::to_string(height_));
   }
   labels.create(image.height, image.width, CV_8UC1);
-  const uint8_t* table = lut.data();
-  const int bits = lut.bitsPerChannel();
+  const uint8_t* table = lut.table;
+  const int bits = lut.bits;
   for (int v = 0; v < image.height; ++v) {
     const uint8_t* in = image.data + static_cast<size_t>(v) * image.step;
     uint8_t* out = labels.ptr<uint8_t>(v);

@@ -57,7 +57,7 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::mutex mutex_;  // guards everything below
   std::string config_error_;
   std::unique_ptr<core::OmniCameraModel> camera_;
-  std::unique_ptr<core::LutViewSegmenter> segmenter_;
+  std::unique_ptr<core::Segmenter> segmenter_;
   core::FeatureParams feature_params_;
   bool lazy_ = false;
   bool debug_addresses_ = false;
@@ -122,7 +122,7 @@ bool SegmentationNodelet::configure(std::string* error) {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     camera_ = std::make_unique<core::OmniCameraModel>(calibration.camera);
-    segmenter_ = std::make_unique<core::LutViewSegmenter>(calibration.camera);
+    segmenter_ = std::make_unique<core::Segmenter>(calibration.camera);
     feature_params_ = fp;
     queue_size_ = static_cast<size_t>(queue_size);
     max_wait_s_ = max_wait;

@@ -93,7 +93,7 @@ act_color::ColorLutConstPtr trainerCallback(ActTrainer& trainer, const sensor_ms
 // The segmentation nodelet's per-image work (src/nodelets/segmentation_nodelet.cpp, process): a
 // view of the message, the labels written straight into a new mono8 message with the shared
 // table (no copy of it).
-sensor_msgs::ImageConstPtr segmentationCallback(const core::LutViewSegmenter& segmenter,
+sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter,
                                                 const sensor_msgs::ImageConstPtr& image,
                                                 const act_color::ColorLutConstPtr& lut) {
   ImageView v;
@@ -122,7 +122,7 @@ sensor_msgs::ImageConstPtr segmentationCallback(const core::LutViewSegmenter& se
 // segmentation; labels -> a sink.
 class RosPipeline {
  public:
-  RosPipeline(ActTrainer* trainer, const core::LutViewSegmenter* segmenter) : trainer_(trainer), segmenter_(segmenter) {
+  RosPipeline(ActTrainer* trainer, const core::Segmenter* segmenter) : trainer_(trainer), segmenter_(segmenter) {
     nh_.setCallbackQueue(&queue_);
     image_pub_ = nh_.advertise<sensor_msgs::Image>("act_benchmark/image", 2);
     lut_pub_ = nh_.advertise<act_color::ColorLut>("act_benchmark/color_lut", 2);
@@ -174,7 +174,7 @@ class RosPipeline {
   void onLabels(const sensor_msgs::ImageConstPtr&) { ++labels_; }
 
   ActTrainer* trainer_;
-  const core::LutViewSegmenter* segmenter_;
+  const core::Segmenter* segmenter_;
   ros::CallbackQueue queue_;
   ros::NodeHandle nh_;
   ros::Publisher image_pub_, lut_pub_, labels_pub_;
@@ -209,7 +209,7 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
   }
   const core::Segmenter segmenter(cal.camera);
   const core::Segmenter unmasked;  // every pixel, as the baselines
-  const core::LutViewSegmenter lut_view_segmenter(cal.camera);
+  const core::Segmenter lut_view_segmenter(cal.camera);
   const auto boxes = tools::boxesFromClusters(trainer.clusters());
   const tools::CmvisionClassifier cmvision(boxes);
   const tools::InRangeClassifier in_range(boxes);

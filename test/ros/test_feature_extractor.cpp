@@ -19,7 +19,7 @@ core::Calibration calibration() {
   return core::loadCalibration(ACT_SOURCE_DIR "/config/calibration/msl_2007_580.yaml");
 }
 
-TEST(LutViewSegmenter, SameLabelsAsSegmenter) {
+TEST(Segmenter, ABorrowedTableClassifiesLikeTheOwnedOne) {
   const core::Calibration cal = calibration();
   core::ActTrainer trainer(cal);
   const core::Pose2D pose{-1.5, 1.0, 0.4};
@@ -30,7 +30,7 @@ TEST(LutViewSegmenter, SameLabelsAsSegmenter) {
   core::Segmenter(cal.camera).classify(trainer.lut(), view, expected);
   core::LutView lut{trainer.lut().data(), trainer.lut().size(), trainer.lut().bitsPerChannel(),
                     trainer.lut().colorSpace()};
-  const core::LutViewSegmenter segmenter(cal.camera);
+  const core::Segmenter segmenter(cal.camera);
   segmenter.classify(lut, view, labels);
   EXPECT_EQ(cv::countNonZero(labels != expected), 0);
   EXPECT_GT(cv::countNonZero(labels == core::kGreen), 50000);

@@ -14,30 +14,6 @@
 namespace act_color {
 namespace core {
 
-// A look-up table owned by someone else (e.g. a shared, immutable ColorLut message): lets the
-// segmentation classify with a table it must not copy.
-struct LutView {
-  const uint8_t* table = nullptr;
-  size_t size = 0;
-  int bits = 6;
-  ColorSpace space = ColorSpace::kRgb;
-};
-
-// Classifies whole images with a borrowed table; the same result as Segmenter::classify with a
-// ColorLut holding the same cells (pixels outside the mirror are kUnknown).
-class LutViewSegmenter {
- public:
-  explicit LutViewSegmenter(const CameraCalibration& camera);
-  // Throws std::invalid_argument when the table is inconsistent, its color space does not fit the
-  // image or the image size does not fit the camera.
-  void classify(const LutView& lut, const ImageView& image, cv::Mat& labels) const;
-
- private:
-  int width_;
-  int height_;
-  std::vector<std::pair<int, int>> spans_;  // per row: half-open column span inside the mirror
-};
-
 enum class FeatureType : uint8_t { kLinePoint = 0, kYellowGoal = 1, kBlueGoal = 2, kBall = 3, kObstacle = 4 };
 
 struct Feature {

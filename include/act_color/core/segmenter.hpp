@@ -10,6 +10,15 @@
 namespace act_color {
 namespace core {
 
+// A look-up table owned by someone else (e.g. a shared, immutable ColorLut message): the
+// segmentation classifies with a table it must not copy.
+struct LutView {
+  const uint8_t* table = nullptr;
+  size_t size = 0;
+  int bits = 6;
+  ColorSpace space = ColorSpace::kRgb;
+};
+
 // Classifies whole images with a look-up table.
 class Segmenter {
  public:
@@ -22,6 +31,8 @@ class Segmenter {
   // std::invalid_argument when the table's color space does not fit the image's format or the
   // image size does not fit the camera.
   void classify(const ColorLut& lut, const ImageView& image, cv::Mat& labels) const;
+  // The same with a borrowed table; also throws when the view is inconsistent (size vs bits).
+  void classify(const LutView& lut, const ImageView& image, cv::Mat& labels) const;
 
  private:
   int width_ = 0;
