@@ -12,17 +12,13 @@ ColorLut::ColorLut(int bits_per_channel, ColorSpace space)
   if (bits_per_channel < 1 || bits_per_channel > 8) {
     throw std::invalid_argument("lut_bits must be in [1, 8], is " + std::to_string(bits_per_channel));
   }
-  table_.assign(size_t{1} << (3 * bits_), kUnknown);
+  clear();
 }
 
-void ColorLut::clear() { std::fill(table_.begin(), table_.end(), static_cast<uint8_t>(kUnknown)); }
-
-std::array<uint32_t, kNumClasses> ColorLut::cellCounts() const {
-  std::array<uint32_t, kNumClasses> counts{};
-  for (uint8_t c : table_) {
-    if (c < kNumClasses) ++counts[c];
-  }
-  return counts;
+void ColorLut::clear() {
+  table_.assign(size_t{1} << (3 * bits_), kUnknown);
+  counts_.fill(0);
+  counts_[kUnknown] = static_cast<uint32_t>(table_.size());
 }
 
 void ColorLut::assign(const std::vector<uint8_t>& table) {
@@ -31,6 +27,10 @@ void ColorLut::assign(const std::vector<uint8_t>& table) {
                                 std::to_string(table_.size()));
   }
   table_ = table;
+  counts_.fill(0);
+  for (uint8_t c : table_) {
+    if (c < kNumClasses) ++counts_[c];
+  }
 }
 
 }  // namespace core

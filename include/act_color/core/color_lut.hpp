@@ -25,11 +25,16 @@ class ColorLut {
   }
   uint8_t classOf(uint8_t c0, uint8_t c1, uint8_t c2) const { return table_[index(c0, c1, c2)]; }
   uint8_t at(uint32_t cell) const { return table_[cell]; }
-  void set(uint32_t cell, uint8_t class_id) { table_[cell] = class_id; }
+  void set(uint32_t cell, uint8_t class_id) {
+    uint8_t& current = table_[cell];
+    if (current < kNumClasses) --counts_[current];
+    if (class_id < kNumClasses) ++counts_[class_id];
+    current = class_id;
+  }
   void clear();
 
-  // Cells per class id.
-  std::array<uint32_t, kNumClasses> cellCounts() const;
+  // Cells per class id; kept up to date by set(), clear() and assign(), so O(1).
+  std::array<uint32_t, kNumClasses> cellCounts() const { return counts_; }
 
   const std::vector<uint8_t>& table() const { return table_; }
   // Replaces the table; `table.size()` must equal size().
@@ -41,6 +46,7 @@ class ColorLut {
   int shift_;
   ColorSpace space_;
   std::vector<uint8_t> table_;
+  std::array<uint32_t, kNumClasses> counts_{};  // cells per class id < kNumClasses
 };
 
 }  // namespace core
