@@ -75,9 +75,21 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
     last_samples_ = 0;
     return 0;
   }
-  ClusterParams no_growth = params;
-  no_growth.zeta = std::numeric_limits<double>::infinity();  // no doubling
-  update(inliers_, no_growth);
+  // eq. 4 from the inliers.
+  Eigen::Vector3d inlier_mean = Eigen::Vector3d::Zero();
+  for (const auto& c : inliers_) inlier_mean += c.cast<double>();
+  inlier_mean /= static_cast<double>(inliers_.size());
+  mean_ = (params.eta * mean_ + inlier_mean) / (params.eta + 1.0);
+  // eq. 5 with the spread of all colors by their median distance (robust to up to half of them
+  // being outliers): the inliers alone could never show that a cluster seeded too small is too
+  // small. The spread may at most double sigma in one cycle, so that one frame of wrong colors
+  // cannot blow the cluster up.
+  distances_.clear();
+  for (const auto& c : colors) distances_.push_back((c.cast<double>() - mean_).norm());
+  std::nth_element(distances_.begin(), distances_.begin() + distances_.size() / 2, distances_.end());
+  const double spread = std::min(1.126 * distances_[distances_.size() / 2], 2.0 * sigma_);
+  sigma_ = std::max((params.eta * sigma_ + spread) / (params.eta + 1.0), params.sigma_min);
+  last_samples_ = static_cast<unsigned>(inliers_.size());
   return last_samples_;
 }
 

@@ -40,8 +40,9 @@ class ClassCluster {
 
   // Extension (ActParams::robust_clusters) for classes whose expected pixels may show something
   // else (a robot in front of a goal, a wrong pose): an untrained cluster is seeded from the
-  // per-channel median and the median distance; a trained one is updated by eq. 4-5 from the
-  // colors within zeta * sigma only (at least two), without doubling. Returns the inliers used.
+  // per-channel median and the median distance; a trained one moves its mean by eq. 4 towards the
+  // colors within zeta * sigma (at least two) and its sigma by eq. 5 towards the median spread of
+  // all colors (at most twice sigma), without doubling. Returns the inliers used.
   unsigned updateFromInliers(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
 
   // A global change of light, modelled as per-channel gains about a pivot (0 for R, G, B and Y;
@@ -58,6 +59,7 @@ class ClassCluster {
   unsigned last_samples_ = 0;
   bool trained_ = false;
   std::vector<Eigen::Vector3f> inliers_;  // scratch
+  std::vector<double> distances_;         // scratch
 };
 
 }  // namespace core
