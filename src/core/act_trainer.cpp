@@ -18,6 +18,9 @@ void requireRange(const char* name, double value, double lo, double hi, bool lo_
   }
 }
 
+// Largest ratio between the per-channel gains of a change of light (see cycle()).
+constexpr double kMaxGainSpread = 2.5;
+
 }  // namespace
 
 void ActParams::validate() const {
@@ -31,6 +34,22 @@ void ActParams::validate() const {
   requireRange("lut_bits", lut_bits, 1, 8);
   requireRange("add_neighbourhood_cells", add_neighbourhood_cells, 0, 3);
   requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
+  requireRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
+}
+
+void ActParams::switchOffExtensions() {
+  seed_clusters = false;
+  add_neighbourhood_cells = 0;
+  robust_clusters = false;
+  light_compensation = false;
+  removal_protect_cycles = 0;
+  robots_train_black = false;
+}
+
+ActParams ActParams::paper() {
+  ActParams p;
+  p.switchOffExtensions();
+  return p;
 }
 
 ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
@@ -43,6 +62,7 @@ ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
 void ActTrainer::reset(ColorSpace space) {
   lut_ = ColorLut(params_.lut_bits, space);
   confirmed_.assign(lut_.size(), 0);
+  neighbour_only_.assign(lut_.size(), 0);
   for (auto& cluster : clusters_) cluster.reset(255.0);
   space_known_ = true;
 }
@@ -67,6 +87,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   }
   lut_ = lut;
   confirmed_.assign(lut_.size(), 0);
+  neighbour_only_.assign(lut_.size(), 0);
   space_known_ = true;
 }
 
@@ -88,6 +109,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
   if (params_.robust_clusters && claimedByOtherClass(color, lut_.at(cell), k)) return 0;
   confirmed_[cell] = static_cast<uint32_t>(revision_ + 1);
+  neighbour_only_[cell] = 0;
   if (lut_.at(cell) != k) {
     lut_.set(cell, k);
     ++changed;
@@ -110,6 +132,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
         if (distance >= radius) continue;
         if (claimedByOtherClass(centre, current, k)) continue;
         lut_.set(neighbour, k);
+        neighbour_only_[neighbour] = 1;
         ++changed;
       }
     }
@@ -140,25 +163,45 @@ bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t curre
 void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot) {
   const ClusterParams cluster_params = clusterParams();
   for (auto& cluster : clusters_) cluster.applyGain(gain, pivot, cluster_params);
-  // Every mapped cell moves to where its color is under the new light; moved cells win over
-  // what was there (stale mappings of the old light), the rest stays.
+  // Every mapped cell moves to where its colors are under the new light: the cells whose centres
+  // lie in the image of the cell's box of colors take its class, or, when a gain below 1 shrinks
+  // the box between two centres, the cell of its mapped centre. Under a gain above 1 the moved
+  // cells thus leave no holes between them, and a gain near 1 does not dilate the classes. Moved
+  // cells win over what was there (stale mappings of the old light), the rest stays.
   const int bits = lut_.bitsPerChannel();
-  const int shift = 8 - bits;
-  const double half = 0.5 * (1 << shift);
+  const int cells = 1 << bits;
+  const double width = 1 << (8 - bits);
   warped_.assign(lut_.table().begin(), lut_.table().end());
+  warped_neighbour_only_.assign(neighbour_only_.begin(), neighbour_only_.end());
   const uint32_t mask = (1u << bits) - 1;
   for (uint32_t cell = 0; cell < lut_.size(); ++cell) {
     const uint8_t k = lut_.at(cell);
     if (k == kUnknown || k >= kNumClasses) continue;
-    uint8_t moved[3];
+    int first[3], last[3];
     const uint32_t channel_cells[3] = {cell >> (2 * bits), (cell >> bits) & mask, cell & mask};
     for (int ch = 0; ch < 3; ++ch) {
-      const double value = pivot[ch] + ((channel_cells[ch] << shift) + half - pivot[ch]) * gain[ch];
-      moved[ch] = static_cast<uint8_t>(std::clamp(value, 0.0, 255.0));
+      // The cell's colors map to [lo, hi) under the new light (gains are positive).
+      const double lo = pivot[ch] + (channel_cells[ch] * width - pivot[ch]) * gain[ch];
+      const double hi = pivot[ch] + ((channel_cells[ch] + 1) * width - pivot[ch]) * gain[ch];
+      // Centres (i + 0.5) * width in [lo, hi).
+      first[ch] = static_cast<int>(std::ceil(lo / width - 0.5));
+      last[ch] = static_cast<int>(std::ceil(hi / width - 0.5)) - 1;
+      if (last[ch] < first[ch]) first[ch] = last[ch] = static_cast<int>(std::floor(0.5 * (lo + hi) / width));
+      first[ch] = std::clamp(first[ch], 0, cells - 1);
+      last[ch] = std::clamp(last[ch], first[ch], cells - 1);
     }
-    warped_[lut_.index(moved[0], moved[1], moved[2])] = k;
+    for (int a = first[0]; a <= last[0]; ++a) {
+      for (int b = first[1]; b <= last[1]; ++b) {
+        for (int d = first[2]; d <= last[2]; ++d) {
+          const uint32_t target = (static_cast<uint32_t>(a) << (2 * bits)) | (static_cast<uint32_t>(b) << bits) | d;
+          warped_[target] = k;
+          warped_neighbour_only_[target] = neighbour_only_[cell];
+        }
+      }
+    }
   }
   lut_.assign(warped_);
+  neighbour_only_.swap(warped_neighbour_only_);
   // Confirmations were made under the old light: colors of the old light that now show up off the
   // field must not be protected from removal.
   std::fill(confirmed_.begin(), confirmed_.end(), 0u);
@@ -251,9 +294,14 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       // (in YUV, chroma scales with luma under a change of light level).
       const double fallback = std::max(0.1, gain.maxCoeff());
       for (int c = 0; c < 3; ++c) gain[c] = std::clamp(gain[c] < 0 ? fallback : gain[c], 0.1, 10.0);
-      applyLightChange(gain, pivot);
-      stats.light_change = true;
-      stats.light_gain = gain.cast<float>();
+      // Light changes its level and, within limits, its color temperature; gains further apart
+      // than kMaxGainSpread are a change of what the camera sees (say, a poster on the carpet),
+      // which the clusters follow by themselves.
+      if (gain.maxCoeff() <= kMaxGainSpread * gain.minCoeff()) {
+        applyLightChange(gain, pivot);
+        stats.light_change = true;
+        stats.light_gain = gain.cast<float>();
+      }
     }
   }
   for (int k = 1; k < kNumClasses; ++k) {
@@ -266,7 +314,9 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
 
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
-  for (size_t i = randomStart(params_.add_stride); i < pixels; i += params_.add_stride) {
+  const int add_stride =
+      stats.light_change ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
+  for (size_t i = randomStart(add_stride); i < pixels; i += add_stride) {
     const uint8_t k = expected(i);
     if (k == kUnknown || k >= kNumClasses) continue;
     uint8_t c[3];
@@ -307,8 +357,10 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       continue;
     }
     const ClassCluster& cluster = clusters_[k];
-    if ((cluster.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() > params_.xi * cluster.sigma()) {
+    if (neighbour_only_[cell] ||
+        (cluster.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() > params_.xi * cluster.sigma()) {
       lut_.set(cell, kUnknown);
+      neighbour_only_[cell] = 0;
       ++stats.removed[k];
     }
   }

@@ -68,7 +68,7 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   core::ActParams params_;
   bool params_changed_ = false;
   std::optional<core::Pose2D> initial_pose_;
-  int bootstrap_cycles_ = 20;
+  int bootstrap_cycles_ = core::kDefaultBootstrapCycles;
   bool bootstrap_at_first_pose_ = false;
   bool has_table_ = false;  // bootstrapped, loaded or trained at least once
   std::string lut_file_;
@@ -138,6 +138,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
   params.add_neighbourhood_cells = pnh_.param("add_neighbourhood_cells", params.add_neighbourhood_cells);
   params.robust_clusters = pnh_.param("robust_clusters", params.robust_clusters);
   params.light_compensation = pnh_.param("light_compensation", params.light_compensation);
+  params.light_change_add_stride = pnh_.param("light_change_add_stride", params.light_change_add_stride);
   params.removal_protect_cycles = pnh_.param("removal_protect_cycles", params.removal_protect_cycles);
   params.robots_train_black = pnh_.param("robots_train_black", params.robots_train_black);
   try {
@@ -156,7 +157,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
     }
     initial_pose_ = p;
   }
-  bootstrap_cycles_ = pnh_.param("bootstrap_cycles", 20);
+  bootstrap_cycles_ = pnh_.param("bootstrap_cycles", core::kDefaultBootstrapCycles);
   bootstrap_at_first_pose_ = pnh_.param("bootstrap_at_first_pose", false);
   if (bootstrap_cycles_ < 1 || bootstrap_cycles_ > 1000) {
     *error = "~bootstrap_cycles must be in [1, 1000], is " + std::to_string(bootstrap_cycles_);

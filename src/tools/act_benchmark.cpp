@@ -203,7 +203,7 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
   std::cerr << "act_benchmark: " << sizeName(w, h) << ": rendering frames and training the table\n";
   std::vector<Frame> frames = renderFrames(cal, 4);
   ActTrainer trainer(cal);
-  trainer.bootstrap(view(frames[0]), frames[0].pose, 20);
+  trainer.bootstrap(view(frames[0]), frames[0].pose, core::kDefaultBootstrapCycles);
   for (int r = 0; r < 3; ++r) {
     for (const Frame& f : frames) trainer.cycle(view(f), f.pose);
   }
@@ -362,7 +362,7 @@ int main(int argc, char** argv) {
   if (callgrind_cycles > 0) {
     std::vector<Frame> frames = renderFrames(base, 4);
     ActTrainer trainer(base);
-    trainer.bootstrap(view(frames[0]), frames[0].pose, 20);
+    trainer.bootstrap(view(frames[0]), frames[0].pose, core::kDefaultBootstrapCycles);
     for (const Frame& f : frames) trainer.cycle(view(f), f.pose);
     runCallgrindCycles(trainer, frames, callgrind_cycles);
     std::cout << "act_benchmark: " << callgrind_cycles << " ACT cycles on "

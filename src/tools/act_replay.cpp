@@ -21,10 +21,10 @@ void printUsage(std::ostream& out) {
          "  --seed N             random start pixels (default 1)\n"
          "  --zeta X --xi X --eta X --sigma-min X\n"
          "  --cluster-stride N --add-stride N --remove-stride N --lut-bits N\n"
-         "  --paper              the paper's algorithm exactly (no cluster seeding, no neighbourhood additions)\n"
+         "  --paper              the paper's algorithm exactly (every extension off)\n"
          "  --neighbourhood-cells N  an added color also adds cells within n cells (default 1)\n"
          "  --removal-protect-cycles N  cells confirmed in the field within n cycles are not removed (default 10)\n"
-         "  --bootstrap-cycles N cycles on the first image with a pose (default 20)\n"
+         "  --bootstrap-cycles N cycles on the first image with a pose (default 100)\n"
          "  --lut-every N        write /act/color_lut with every n-th frame (default 1)\n"
          "  --adapt-frames N     frames after each event left out of the *_ad figures (default 12)\n"
          "  --csv FILE           per-frame recall and precision per class\n"
@@ -85,8 +85,7 @@ int main(int argc, char** argv) {
       } else if (arg == "--lut-bits") {
         p.lut_bits = integer();
       } else if (arg == "--paper") {
-        p.seed_clusters = false;
-        p.add_neighbourhood_cells = 0;
+        p.switchOffExtensions();
       } else if (arg == "--neighbourhood-cells") {
         p.add_neighbourhood_cells = integer();
       } else if (arg == "--removal-protect-cycles") {

@@ -190,6 +190,82 @@ TEST_F(ActTrainerTest, RemovesOffFieldColorsBeyondXiSigma) {
   EXPECT_EQ(keep.lut().classOf(150, 60, 90), kGreen);
 }
 
+TEST_F(ActTrainerTest, NeighbourCellsSeenOffTheFieldAreRemovedWhateverTheirDistance) {
+  const Pose2D near_corner{7.5, 4.5, 0.0};
+  auto frame = paintFlatFrame(model, near_corner, 1.0, 1);
+  ActParams p;
+  p.removal_protect_cycles = 0;
+  p.xi = 50.0;  // every green cell lies within xi * sigma: 2.4 alone would remove nothing
+  ActTrainer trainer(cal, p);
+  trainer.bootstrap(view(frame.rgb), near_corner, 30);
+  const ClassCluster& green = trainer.clusters()[kGreen];
+  const ColorLut& lut = trainer.lut();
+  // A green cell that only a neighbour put there, and one confirmed by samples of its own.
+  const int bits = lut.bitsPerChannel(), shift = 8 - bits;
+  auto centre = [&](uint32_t cell) {
+    const uint32_t mask = (1u << bits) - 1;
+    return cv::Vec3b(static_cast<uint8_t>(((cell >> (2 * bits)) << shift) + (1 << (shift - 1))),
+                     static_cast<uint8_t>((((cell >> bits) & mask) << shift) + (1 << (shift - 1))),
+                     static_cast<uint8_t>(((cell & mask) << shift) + (1 << (shift - 1))));
+  };
+  int64_t neighbour = -1, confirmed = -1;
+  for (uint32_t cell = 0; cell < lut.size(); ++cell) {
+    if (lut.at(cell) != kGreen) continue;
+    const cv::Vec3b c = centre(cell);
+    if ((green.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() > p.xi * green.sigma()) continue;
+    (trainer.neighbourOnly(cell) ? neighbour : confirmed) = cell;
+  }
+  ASSERT_GE(neighbour, 0) << "no neighbour-only green cell within xi sigma";
+  ASSERT_GE(confirmed, 0);
+  // Off the carpet: half the rows in the neighbour's colour, half in the confirmed one's.
+  const PoseTransform t(near_corner);
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      if (model.geometricClass(v * 580 + u, t) == kUnknown) {
+        frame.rgb.at<cv::Vec3b>(v, u) = centre(static_cast<uint32_t>(v % 2 ? neighbour : confirmed));
+      }
+    }
+  }
+  trainer.cycle(view(frame.rgb), near_corner);
+  EXPECT_EQ(trainer.lut().at(static_cast<uint32_t>(neighbour)), kUnknown);
+  EXPECT_EQ(trainer.lut().at(static_cast<uint32_t>(confirmed)), kGreen);  // 2.4: within xi sigma stays
+}
+
+TEST_F(ActTrainerTest, ABrighteningMovesTheTableWithoutHoles) {
+  // Trained on the dark frame, then the light doubles. Without neighbourhood additions and with
+  // the usual add stride in the cycle of the change, what the classes keep comes from the moved
+  // table: each cell's colors now span two cells per channel, all of which must take the class.
+  const auto dark = paintFlatFrame(model, pose, 0.5, 1);
+  const auto bright = paintFlatFrame(model, pose, 1.0, 2);
+  ActParams p;
+  p.add_neighbourhood_cells = 0;
+  p.light_change_add_stride = p.add_stride;
+  ActTrainer trainer(cal, p);
+  trainer.bootstrap(view(dark.rgb), pose, 100);
+  const auto before = evaluate(trainer, dark, cal);
+  const CycleStats s = trainer.cycle(view(bright.rgb), pose);
+  ASSERT_TRUE(s.light_change);
+  EXPECT_NEAR(s.light_gain[1], 2.0, 0.2);
+  const auto after = evaluate(trainer, bright, cal);
+  for (int k : {kGreen, kYellow, kBlue}) {
+    EXPECT_GT(after.recall(k), before.recall(k) - 0.05) << className(k);
+  }
+}
+
+TEST_F(ActTrainerTest, GainsFarApartAreNotAChangeOfLight) {
+  // The carpet turns magenta: green's mean jumps, but by gains no light produces (R x4, G x0.3).
+  auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  ActTrainer trainer(cal);
+  trainer.bootstrap(view(frame.rgb), pose, 20);
+  frame.rgb.setTo(cv::Vec3b(200, 40, 200), frame.labels == kGreen);
+  for (int i = 0; i < 5; ++i) EXPECT_FALSE(trainer.cycle(view(frame.rgb), pose).light_change);
+  // The paper's darkening is one.
+  const auto dark = paintFlatFrame(model, pose, 0.5, 2);
+  ActTrainer other(cal);
+  other.bootstrap(view(paintFlatFrame(model, pose, 1.0, 1).rgb), pose, 20);
+  EXPECT_TRUE(other.cycle(view(dark.rgb), pose).light_change);
+}
+
 TEST_F(ActTrainerTest, LearnsAFrameAndAdaptsToDarkeningInRgbAndYuv) {
   const auto bright = paintFlatFrame(model, pose, 1.0, 1);
   const auto dark = paintFlatFrame(model, pose, 0.5, 2);  // the paper's 50% darkening
@@ -233,13 +309,7 @@ TEST_F(ActTrainerTest, LearnsAFrameAndAdaptsToDarkeningInRgbAndYuv) {
 
 TEST_F(ActTrainerTest, ThePaperAlgorithmAloneAdaptsMoreSlowly) {
   // All extensions off: eq. 2-5 and 2.3/2.4 as published. Green still recovers within 12 cycles.
-  ActParams paper;
-  paper.seed_clusters = false;
-  paper.add_neighbourhood_cells = 0;
-  paper.robust_clusters = false;
-  paper.light_compensation = false;
-  paper.removal_protect_cycles = 0;
-  paper.robots_train_black = false;
+  const ActParams paper = ActParams::paper();
   const auto bright = paintFlatFrame(model, pose, 1.0, 1);
   const auto dark = paintFlatFrame(model, pose, 0.5, 2);
   ActTrainer trainer(cal, paper);

@@ -34,7 +34,10 @@ struct ActParams {
   bool seed_clusters = true;
   // An added color also adds the cells within this many cells per channel around it whose
   // centres lie within zeta * sigma_k, unless they belong to a class whose cluster is nearer
-  // (distance in sigmas). Sparse samples then cover a class's colors in a few cycles.
+  // (distance in sigmas). Sparse samples then cover a class's colors in a few cycles. Such a
+  // cell has not been seen in the field itself: until a sample of its own confirms it, it is
+  // removed when seen off the field, whatever its distance from the cluster (off-field colors
+  // near a class, like a whitish hall floor, do not stay in the class by vicinity alone).
   int add_neighbourhood_cells = 1;
   // Classes other than green learn only from colors that fit their cluster (ClassCluster::
   // updateFromInliers), and a color that firmly belongs to another trained class (mapped to it and
@@ -43,8 +46,12 @@ struct ActParams {
   bool robust_clusters = true;
   // When green's colors jump beyond zeta * sigma (a global change of light), the per-channel gain
   // of green's mean is applied to every cluster and to the table, so that all classes follow at
-  // once instead of re-learning from sparse samples.
+  // once instead of re-learning from sparse samples. Gains more than 2.5 times apart are not a
+  // change of light and are left to the clusters.
   bool light_compensation = true;
+  // In the cycle of such a change of light every n-th pixel is added (instead of add_stride), so
+  // that what the moved table misses is filled at once.
+  int light_change_add_stride = 50;
   // A cell confirmed by an in-field sample of its class (within zeta * sigma) in the last n
   // cycles is not removed for being seen off the field: colors seen on both sides (a dark
   // poster like a robot) stay with the class that needs them. 0: the paper's removal.
@@ -56,7 +63,14 @@ struct ActParams {
   bool robots_train_black = true;
 
   void validate() const;
+  // Every extension off: the paper's algorithm exactly.
+  void switchOffExtensions();
+  static ActParams paper();
 };
+
+// Cycles of the start-up training on the first image (paper, section 2): enough for the sparse
+// samples to cover every class's colors, so that later cycles only follow changes.
+constexpr int kDefaultBootstrapCycles = 100;
 
 // What one cycle did.
 struct CycleStats {
@@ -93,6 +107,8 @@ class ActTrainer {
 
   const ColorLut& lut() const { return lut_; }
   const std::array<ClassCluster, kNumClasses>& clusters() const { return clusters_; }
+  // True for a cell mapped by add_neighbourhood_cells that no in-field sample has confirmed yet.
+  bool neighbourOnly(uint32_t cell) const { return neighbour_only_.at(cell) != 0; }
   uint64_t revision() const { return revision_; }
   const ExpectedClassModel& model() const { return model_; }
 
@@ -120,6 +136,9 @@ class ActTrainer {
   std::vector<uint8_t> warped_;
   // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.
   std::vector<uint32_t> confirmed_;
+  // 1 for cells mapped by add_neighbourhood_cells and not yet seen in the field themselves.
+  std::vector<uint8_t> neighbour_only_;
+  std::vector<uint8_t> warped_neighbour_only_;
 };
 
 }  // namespace core

@@ -20,13 +20,13 @@ struct ReplayOptions {
   std::string truth_topic = "/omni/labels_truth";
   std::string events_topic = "/scenario/events";
   core::ActParams params;
-  int bootstrap_cycles = 20;  // cycles on the first image with a pose (paper, section 2)
-  size_t lut_every = 1;       // write /act/color_lut with every n-th frame
-  size_t adapt_frames = 12;   // frames after each event excluded from the "adapted" figures
-  std::string csv_path;       // per-frame recall/precision, when not empty
-  std::string png_dir;        // side-by-side PNGs (image | classified | truth), when not empty
-  size_t png_every = 10;      // of every n-th frame
-  bool progress = true;       // a progress line on stderr every few seconds
+  int bootstrap_cycles = core::kDefaultBootstrapCycles;  // cycles on the first image with a pose (paper, section 2)
+  size_t lut_every = 1;                                  // write /act/color_lut with every n-th frame
+  size_t adapt_frames = 12;                              // frames after each event excluded from the "adapted" figures
+  std::string csv_path;                                  // per-frame recall/precision, when not empty
+  std::string png_dir;    // side-by-side PNGs (image | classified | truth), when not empty
+  size_t png_every = 10;  // of every n-th frame
+  bool progress = true;   // a progress line on stderr every few seconds
 };
 
 struct ReplayResult {
