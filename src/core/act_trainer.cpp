@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -108,7 +109,11 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   uint32_t changed = 0;
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
   if (params_.robust_clusters && claimedByOtherClass(color, lut_.at(cell), k)) return 0;
-  confirmed_[cell] = static_cast<uint32_t>(revision_ + 1);
+  // A cell sampled for k before in this cycle has had its neighbourhood filled with this very
+  // cluster: doing it again changes nothing.
+  const uint32_t this_cycle = static_cast<uint32_t>(revision_ + 1);
+  if (confirmed_[cell] == this_cycle && lut_.at(cell) == k) return 0;
+  confirmed_[cell] = this_cycle;
   neighbour_only_[cell] = 0;
   if (lut_.at(cell) != k) {
     lut_.set(cell, k);
@@ -327,38 +332,62 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
   const double safe_range = model_.safeCarpetRange(pose);
-  // The samples lie far apart in memory: fetch the pixel data some samples ahead.
-  const size_t remove_stride = static_cast<size_t>(params_.remove_stride);
-  const size_t ahead = 16 * remove_stride;
-  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
   const size_t start = randomStart(params_.remove_stride);
-  // Row and column of the sample `ahead` pixels on, kept without divisions.
-  size_t ahead_v = (start + ahead) / width, ahead_u = (start + ahead) % width;
-  for (size_t i = start; i < pixels; i += remove_stride) {
-    model_.prefetchRemoval(i + ahead);
-    if (ahead_v < static_cast<size_t>(image.height)) {
-      __builtin_prefetch(image.data + ahead_v * image.step + ahead_u * bytes_per_pixel);
+  const std::vector<RemovalSample>& samples = removalSamples(start);
+  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
+  // Row and column without a division (exact for any image of less than 2^26 pixels).
+  const double inverse_width = 1.0 / width;
+  auto rowColumn = [&](size_t i, size_t& v, size_t& u) {
+    v = static_cast<size_t>(static_cast<double>(i) * inverse_width);
+    u = i - v * static_cast<size_t>(width);
+    if (u >= static_cast<size_t>(width)) {
+      u -= width;
+      ++v;
     }
-    ahead_u += remove_stride;
-    while (ahead_u >= static_cast<size_t>(width)) {
-      ahead_u -= width;
-      ++ahead_v;
+  };
+  // |mu_k - c| > xi * sigma_k, compared as squared distances in float.
+  std::array<Eigen::Vector3f, kNumClasses> remove_mean;
+  std::array<float, kNumClasses> remove_radius_sq;
+  for (int k = 0; k < kNumClasses; ++k) {
+    remove_mean[k] = clusters_[k].mean().cast<float>();
+    const double radius = params_.xi * clusters_[k].sigma();
+    remove_radius_sq[k] = static_cast<float>(radius * radius);
+  }
+  // The samples that may be off the field: a prefix of the list.
+  const size_t candidates =
+      static_cast<size_t>(std::partition_point(samples.begin(), samples.end(),
+                                               [&](const RemovalSample& s) {
+                                                 return ExpectedClassModel::mayBeOffField(s.range_m, safe_range);
+                                               }) -
+                          samples.begin());
+  // They lie far apart in memory: fetch their ray and pixel some samples ahead.
+  constexpr size_t kAhead = 16;
+  for (size_t j = 0; j < candidates; ++j) {
+    if (j + kAhead < candidates) {
+      const size_t ahead = samples[j + kAhead].pixel;
+      size_t v, u;
+      rowColumn(ahead, v, u);
+      model_.prefetchRemoval(ahead);
+      __builtin_prefetch(image.data + v * image.step + u * bytes_per_pixel);
     }
-    if (!model_.mayBeOffField(i, safe_range)) continue;
-    if (!model_.offField(i, transform)) continue;
-    ++stats.remove_candidates;
+    // The color first: most colors seen off the field are mapped to no class, and then whether
+    // the pixel really is off the field (a ray cast) does not matter.
+    const size_t i = samples[j].pixel;
+    size_t v, u;
+    rowColumn(i, v, u);
     uint8_t c[3];
-    colorAt(i, c);
+    image.color(static_cast<int>(u), static_cast<int>(v), c);
     const uint32_t cell = lut_.index(c[0], c[1], c[2]);
     const uint8_t k = lut_.at(cell);
     if (k == kUnknown || k >= kNumClasses) continue;
+    if (!model_.offField(i, transform)) continue;
+    ++stats.remove_candidates;
     if (confirmed_[cell] != 0 &&
         revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
       continue;
     }
-    const ClassCluster& cluster = clusters_[k];
     if (neighbour_only_[cell] ||
-        (cluster.mean() - Eigen::Vector3d(c[0], c[1], c[2])).norm() > params_.xi * cluster.sigma()) {
+        (remove_mean[k] - Eigen::Vector3f(c[0], c[1], c[2])).squaredNorm() > remove_radius_sq[k]) {
       lut_.set(cell, kUnknown);
       neighbour_only_[cell] = 0;
       ++stats.removed[k];
@@ -366,6 +395,27 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
   ++revision_;
   return stats;
+}
+
+const std::vector<ActTrainer::RemovalSample>& ActTrainer::removalSamples(size_t start) {
+  if (removal_samples_stride_ != params_.remove_stride) {
+    removal_samples_.clear();
+    removal_samples_stride_ = params_.remove_stride;
+  }
+  auto [it, inserted] = removal_samples_.try_emplace(start);
+  if (inserted) {
+    std::vector<RemovalSample>& samples = it->second;
+    const size_t stride = static_cast<size_t>(params_.remove_stride);
+    for (size_t i = start; i < model_.pixels(); i += stride) {
+      const float range = model_.removalRange(i);
+      if (range > -std::numeric_limits<float>::infinity()) {  // not the chassis nor outside the mirror
+        samples.push_back({static_cast<uint32_t>(i), range});
+      }
+    }
+    std::stable_sort(samples.begin(), samples.end(),
+                     [](const RemovalSample& a, const RemovalSample& b) { return a.range_m > b.range_m; });
+  }
+  return it->second;
 }
 
 void ActTrainer::bootstrap(const ImageView& image, const Pose2D& pose, int cycles) {

@@ -82,20 +82,26 @@ ColorClass FieldModel::floorClass(double x_m, double y_m) const {
 
 ColorClass FieldModel::goalHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& dir, double t_max,
                                double* t_hit) const {
+  // Slab test against the axis-aligned goal boxes, with one division per axis for both goals.
+  bool parallel[3];
+  Eigen::Vector3d inverse;
+  for (int a = 0; a < 3; ++a) {
+    parallel[a] = std::abs(dir[a]) < 1e-12;
+    inverse[a] = parallel[a] ? 0.0 : 1.0 / dir[a];
+  }
   ColorClass best = kUnknown;
   double best_t = t_max;
   for (int i = 0; i < 2; ++i) {
-    // Slab test against the axis-aligned goal box.
     double t0 = 0.0;
     double t1 = best_t;
     bool hit = true;
     for (int a = 0; a < 3 && hit; ++a) {
-      if (std::abs(dir[a]) < 1e-12) {
+      if (parallel[a]) {
         hit = origin[a] >= goal_min_[i][a] && origin[a] <= goal_max_[i][a];
         continue;
       }
-      double ta = (goal_min_[i][a] - origin[a]) / dir[a];
-      double tb = (goal_max_[i][a] - origin[a]) / dir[a];
+      double ta = (goal_min_[i][a] - origin[a]) * inverse[a];
+      double tb = (goal_max_[i][a] - origin[a]) * inverse[a];
       if (ta > tb) std::swap(ta, tb);
       t0 = std::max(t0, ta);
       t1 = std::min(t1, tb);

@@ -109,7 +109,14 @@ TEST_F(ActTrainerTest, RemovalExaminesEveryTwentiethOffFieldPixel) {
   const Pose2D near_corner{7.5, 4.5, 0.0};  // much of the view is off the carpet
   const auto frame = paintFlatFrame(model, near_corner, 1.0, 1);
   const auto counts = geometricCounts(model, near_corner);
-  ActTrainer trainer(cal);
+  // Every color mapped to green, and a xi that removes none of them: every off-field sample is
+  // a candidate for removal.
+  ColorLut all_green(6);
+  for (uint32_t cell = 0; cell < all_green.size(); ++cell) all_green.set(cell, kGreen);
+  ActParams p;
+  p.xi = 100.0;
+  ActTrainer trainer(cal, p);
+  trainer.loadTable(all_green);
   const CycleStats s = trainer.cycle(view(frame.rgb), near_corner);
   const double expected = counts[kUnknown] / 20.0;
   EXPECT_NEAR(s.remove_candidates, expected, 0.05 * expected);

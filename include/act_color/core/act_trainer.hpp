@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "act_color/core/calibration.hpp"
@@ -77,7 +78,7 @@ struct CycleStats {
   std::array<uint32_t, kNumClasses> cluster_samples{};  // colors that updated each cluster
   std::array<uint32_t, kNumClasses> added{};            // table cells set to each class
   std::array<uint32_t, kNumClasses> removed{};          // cells of each class cleared
-  uint32_t remove_candidates = 0;                       // off-field pixels examined
+  uint32_t remove_candidates = 0;                       // off-field samples whose color is mapped to a class (2.4)
   uint32_t doublings = 0;                               // sigma doublings over all clusters
   bool color_space_changed = false;                     // table reset for a new color space
   bool light_change = false;                            // light compensation applied
@@ -139,6 +140,17 @@ class ActTrainer {
   // 1 for cells mapped by add_neighbourhood_cells and not yet seen in the field themselves.
   std::vector<uint8_t> neighbour_only_;
   std::vector<uint8_t> warped_neighbour_only_;
+  // The removal step's samples start, start + remove_stride, ... that can ever be off the field,
+  // with their removal range (ExpectedClassModel::removalRange), farthest first: the samples that
+  // may be off the field at a pose are a prefix (range >= safeCarpetRange). Built for each start
+  // when first used; cleared when remove_stride changes. The order does not change the table.
+  struct RemovalSample {
+    uint32_t pixel;
+    float range_m;
+  };
+  const std::vector<RemovalSample>& removalSamples(size_t start);
+  std::unordered_map<size_t, std::vector<RemovalSample>> removal_samples_;
+  int removal_samples_stride_ = 0;
 };
 
 }  // namespace core

@@ -50,12 +50,15 @@ class ExpectedClassModel {
   // For the removal step (2.4): false when geometricClass(pixel_index) cannot be kUnknown, decided
   // from one float per pixel (not imaged, chassis, or a floor point within safe_range_m).
   bool mayBeOffField(size_t pixel_index, double safe_range_m) const {
-    return !(removal_range_m_[pixel_index] < safe_range_m);
+    return mayBeOffField(removal_range_m_[pixel_index], safe_range_m);
   }
+  // The same from the pixel's removal range (for callers that keep a compact copy of them).
+  static bool mayBeOffField(float removal_range_m, double safe_range_m) { return !(removal_range_m < safe_range_m); }
+  float removalRange(size_t pixel_index) const { return removal_range_m_[pixel_index]; }
+  size_t pixels() const { return removal_range_m_.size(); }
   // Hints the cache about a pixel the removal step will look at soon (no effect on results).
   void prefetchRemoval(size_t pixel_index) const {
     if (pixel_index >= removal_range_m_.size()) return;
-    __builtin_prefetch(&removal_range_m_[pixel_index]);
     __builtin_prefetch(&camera_.ray(pixel_index));
   }
   // geometricClass(pixel_index, pose) == kUnknown, computed the same way but without telling lines
