@@ -27,6 +27,7 @@
 #include "act_color/core/segmenter.hpp"
 #include "act_color/ros/conversions.hpp"
 #include "act_color/ros/lut_file.hpp"
+#include "act_color/ros/nodelet_setup.hpp"
 #include "act_color/ros/pose_source.hpp"
 
 namespace act_color {
@@ -88,20 +89,11 @@ class ActTrainerNodelet : public nodelet::Nodelet {
 void ActTrainerNodelet::onInit() {
   nh_ = getNodeHandle();
   pnh_ = getPrivateNodeHandle();
-  updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, getName());
-  updater_->setHardwareID("act_color");
-  updater_->add("ACT trainer", this, &ActTrainerNodelet::diagnose);
-  diagnostics_timer_ = nh_.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_->update(); });
-
-  std::string error;
-  bool ok = false;
-  try {
-    ok = configure(&error);
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
-  if (!ok) {
-    // Stay loaded and harmless: a nodelet that throws or exits takes the whole manager with it.
+  updater_ = ros_conversions::makeDiagnostics(
+      nh_, pnh_, getName(), "ACT trainer", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
+      &diagnostics_timer_);
+  const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
+  if (!error.empty()) {
     NODELET_ERROR("not started: %s", error.c_str());
     std::lock_guard<std::mutex> lock(mutex_);
     config_error_ = error;
@@ -109,18 +101,8 @@ void ActTrainerNodelet::onInit() {
 }
 
 bool ActTrainerNodelet::configure(std::string* error) {
-  const std::string calibration_path = pnh_.param<std::string>("calibration", "");
-  if (calibration_path.empty()) {
-    *error = "parameter ~calibration (path of the calibration file) is not set";
-    return false;
-  }
   core::Calibration calibration;
-  try {
-    calibration = core::loadCalibration(calibration_path);
-  } catch (const std::exception& e) {
-    *error = std::string("bad calibration: ") + e.what();
-    return false;
-  }
+  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, error)) return false;
 
   core::ActParams params;
   params.eta = pnh_.param("eta", params.eta);
@@ -200,8 +182,8 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // Training needs every image, whether or not anyone listens to the outputs.
   const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
   image_sub_ = it_->subscribe("image", 2, &ActTrainerNodelet::onImage, this, hints);
-  NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s", calibration_path.c_str(),
-               calibration.camera.width, calibration.camera.height,
+  NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s",
+               pnh_.param<std::string>("calibration", "").c_str(), calibration.camera.width, calibration.camera.height,
                pose_source_.mode() == ros_conversions::PoseSource::Mode::kTf ? "tf" : "topic",
                has_table_                 ? "loaded"
                : initial_pose_            ? "bootstrap at ~initial_pose"

@@ -23,6 +23,7 @@
 #include "act_color/core/omni_camera_model.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/ros/conversions.hpp"
+#include "act_color/ros/nodelet_setup.hpp"
 #include "act_color/ros/pose_source.hpp"
 
 namespace act_color {
@@ -73,18 +74,11 @@ class SegmentationNodelet : public nodelet::Nodelet {
 void SegmentationNodelet::onInit() {
   nh_ = getNodeHandle();
   pnh_ = getPrivateNodeHandle();
-  updater_ = std::make_unique<diagnostic_updater::Updater>(nh_, pnh_, getName());
-  updater_->setHardwareID("act_color");
-  updater_->add("segmentation", this, &SegmentationNodelet::diagnose);
-  diagnostics_timer_ = nh_.createTimer(ros::Duration(1.0), [this](const ros::TimerEvent&) { updater_->update(); });
-  std::string error;
-  bool ok = false;
-  try {
-    ok = configure(&error);
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
-  if (!ok) {
+  updater_ = ros_conversions::makeDiagnostics(
+      nh_, pnh_, getName(), "segmentation", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
+      &diagnostics_timer_);
+  const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
+  if (!error.empty()) {
     NODELET_ERROR("not started: %s", error.c_str());
     std::lock_guard<std::mutex> lock(mutex_);
     config_error_ = error;
@@ -92,18 +86,8 @@ void SegmentationNodelet::onInit() {
 }
 
 bool SegmentationNodelet::configure(std::string* error) {
-  const std::string calibration_path = pnh_.param<std::string>("calibration", "");
-  if (calibration_path.empty()) {
-    *error = "parameter ~calibration (path of the calibration file) is not set";
-    return false;
-  }
   core::Calibration calibration;
-  try {
-    calibration = core::loadCalibration(calibration_path);
-  } catch (const std::exception& e) {
-    *error = std::string("bad calibration: ") + e.what();
-    return false;
-  }
+  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, error)) return false;
   const int queue_size = pnh_.param("queue_size", 5);
   const double max_wait = pnh_.param("max_wait", 0.2);
   const int history = pnh_.param("table_history", 10);
@@ -148,7 +132,7 @@ bool SegmentationNodelet::configure(std::string* error) {
     }
   });
   connectCb();
-  NODELET_INFO("segmentation ready: calibration %s, %s", calibration_path.c_str(),
+  NODELET_INFO("segmentation ready: calibration %s, %s", pnh_.param<std::string>("calibration", "").c_str(),
                lazy_ ? "inputs subscribed while someone listens" : "always subscribed");
   return true;
 }
