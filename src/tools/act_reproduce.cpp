@@ -120,7 +120,7 @@ void fig1(const core::Calibration& cal, const sim::Renderer& renderer, const std
   };
 
   std::vector<double> zetas, xis;
-  for (double z = 1.0; z <= 4.0 + 1e-9; z += 0.25) zetas.push_back(z);
+  for (double z = 1.0; z <= 6.0 + 1e-9; z += 0.25) zetas.push_back(z);
   for (double x = 0.9; x <= 2.1 + 1e-9; x += 0.15) xis.push_back(x);
   // The paper's intervals of best fitness.
   const std::map<std::string, std::string> paper_zeta = {
@@ -221,7 +221,7 @@ void fig23(const core::Calibration& cal, const sim::Renderer& renderer, const st
   for (int k : trainable()) csv << ",recall_" << className(k);
   csv << "\n";
   summary << "## Figs. 2-3: sudden 50% darkening of a static scene\n\n"
-          << "Trained 20 cycles on the first normal frame plus " << before
+          << "Trained " << core::kDefaultBootstrapCycles << " cycles on the first normal frame plus " << before
           << " normal frames, then darkened frames (brightness and contrast 50%); each frame is trained on and "
              "then classified with the table (the contract's rule). Settle: cycles after the drop until the "
              "class's per-frame recall stays within 0.02 of its final value (mean over the last quarter), both "
