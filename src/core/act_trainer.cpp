@@ -408,7 +408,7 @@ const std::vector<ActTrainer::RemovalSample>& ActTrainer::removalSamples(size_t 
     const size_t stride = static_cast<size_t>(params_.remove_stride);
     for (size_t i = start; i < model_.pixels(); i += stride) {
       const float range = model_.removalRange(i);
-      if (range > -std::numeric_limits<float>::infinity()) {  // not the chassis nor outside the mirror
+      if (range > -std::numeric_limits<float>::infinity()) {  // can be off the field at some pose
         samples.push_back({static_cast<uint32_t>(i), range});
       }
     }

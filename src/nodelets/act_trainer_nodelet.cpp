@@ -44,6 +44,9 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   void trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_hold);
   void publishClassified(const core::ImageView& view, const std_msgs::Header& header);
   void onReconfigure(ActTrainerConfig& config, uint32_t level);
+  // The file of a ~save_lut / ~load_lut request: its path or ~lut_file; false (and res filled)
+  // when neither is set.
+  bool requestPath(const FilePath::Request& req, FilePath::Response& res, std::string* path) const;
   bool onSaveLut(FilePath::Request& req, FilePath::Response& res);
   bool onLoadLut(FilePath::Request& req, FilePath::Response& res);
   bool loadLut(const std::string& path, std::string* message);
@@ -102,7 +105,8 @@ void ActTrainerNodelet::onInit() {
 
 bool ActTrainerNodelet::configure(std::string* error) {
   core::Calibration calibration;
-  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, error)) return false;
+  std::string calibration_path;
+  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, error)) return false;
 
   core::ActParams params;
   params.eta = pnh_.param("eta", params.eta);
@@ -182,8 +186,8 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // Training needs every image, whether or not anyone listens to the outputs.
   const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
   image_sub_ = it_->subscribe("image", 2, &ActTrainerNodelet::onImage, this, hints);
-  NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s",
-               pnh_.param<std::string>("calibration", "").c_str(), calibration.camera.width, calibration.camera.height,
+  NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s", calibration_path.c_str(),
+               calibration.camera.width, calibration.camera.height,
                pose_source_.mode() == ros_conversions::PoseSource::Mode::kTf ? "tf" : "topic",
                has_table_                 ? "loaded"
                : initial_pose_            ? "bootstrap at ~initial_pose"
@@ -340,13 +344,17 @@ bool ActTrainerNodelet::loadLut(const std::string& path, std::string* message) {
   return true;
 }
 
+bool ActTrainerNodelet::requestPath(const FilePath::Request& req, FilePath::Response& res, std::string* path) const {
+  *path = req.path.empty() ? lut_file_ : req.path;
+  if (!path->empty()) return true;
+  res.success = false;
+  res.message = "no path given and ~lut_file is not set";
+  return false;
+}
+
 bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& res) {
-  const std::string path = req.path.empty() ? lut_file_ : req.path;
-  if (path.empty()) {
-    res.success = false;
-    res.message = "no path given and ~lut_file is not set";
-    return true;
-  }
+  std::string path;
+  if (!requestPath(req, res, &path)) return true;
   act_color::ColorLutPtr msg;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -368,12 +376,8 @@ bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& re
 }
 
 bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& res) {
-  const std::string path = req.path.empty() ? lut_file_ : req.path;
-  if (path.empty()) {
-    res.success = false;
-    res.message = "no path given and ~lut_file is not set";
-    return true;
-  }
+  std::string path;
+  if (!requestPath(req, res, &path)) return true;
   res.success = loadLut(path, &res.message);
   if (!res.success) NODELET_ERROR("~load_lut: %s", res.message.c_str());
   return true;

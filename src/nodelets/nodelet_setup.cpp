@@ -26,14 +26,15 @@ std::string runConfigure(const std::function<bool(std::string*)>& configure) {
   return error.empty() ? "configuration failed" : error;
 }
 
-bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* error) {
-  const std::string path = pnh.param<std::string>("calibration", "");
-  if (path.empty()) {
+bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,
+                          std::string* error) {
+  *path = pnh.param<std::string>("calibration", "");
+  if (path->empty()) {
     *error = "parameter ~calibration (path of the calibration file) is not set";
     return false;
   }
   try {
-    *calibration = core::loadCalibration(path);
+    *calibration = core::loadCalibration(*path);
   } catch (const std::exception& e) {
     *error = std::string("bad calibration: ") + e.what();
     return false;

@@ -87,7 +87,8 @@ void SegmentationNodelet::onInit() {
 
 bool SegmentationNodelet::configure(std::string* error) {
   core::Calibration calibration;
-  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, error)) return false;
+  std::string calibration_path;
+  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, error)) return false;
   const int queue_size = pnh_.param("queue_size", 5);
   const double max_wait = pnh_.param("max_wait", 0.2);
   const int history = pnh_.param("table_history", 10);
@@ -132,7 +133,7 @@ bool SegmentationNodelet::configure(std::string* error) {
     }
   });
   connectCb();
-  NODELET_INFO("segmentation ready: calibration %s, %s", pnh_.param<std::string>("calibration", "").c_str(),
+  NODELET_INFO("segmentation ready: calibration %s, %s", calibration_path.c_str(),
                lazy_ ? "inputs subscribed while someone listens" : "always subscribed");
   return true;
 }
@@ -247,22 +248,10 @@ void SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const
   std::string error;
   if (!ros_conversions::imageView(*image, &view, &error)) throw std::invalid_argument(error);
   // Labels written straight into the outgoing message.
-  auto labels_msg = boost::make_shared<sensor_msgs::Image>();
-  labels_msg->header = image->header;
-  labels_msg->height = image->height;
-  labels_msg->width = image->width;
-  labels_msg->encoding = "mono8";
-  labels_msg->step = image->width;
-  labels_msg->data.assign(static_cast<size_t>(image->width) * image->height, core::kUnknown);
-  cv::Mat labels(static_cast<int>(image->height), static_cast<int>(image->width), CV_8UC1, labels_msg->data.data());
+  cv::Mat labels;
+  sensor_msgs::ImagePtr labels_msg = ros_conversions::newLabelsMsg(*image, &labels);
   if (lut) {
-    core::LutView table;
-    table.table = lut->table.data();
-    table.size = lut->table.size();
-    table.bits = lut->bits_per_channel;
-    table.space =
-        lut->color_space == act_color::ColorLut::COLOR_SPACE_YUV ? core::ColorSpace::kYuv : core::ColorSpace::kRgb;
-    segmenter_->classify(table, view, labels);  // throws for a wrong size or color space
+    segmenter_->classify(ros_conversions::lutView(*lut), view, labels);  // throws for a wrong size or color space
   } else if (image->width != static_cast<uint32_t>(camera_->width()) ||
              image->height != static_cast<uint32_t>(camera_->height())) {
     throw std::invalid_argument("image is " + std::to_string(image->width) + "x" + std::to_string(image->height) +

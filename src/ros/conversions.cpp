@@ -5,6 +5,13 @@
 
 namespace act_color {
 namespace ros_conversions {
+namespace {
+
+core::ColorSpace colorSpace(const act_color::ColorLut& msg) {
+  return msg.color_space == act_color::ColorLut::COLOR_SPACE_YUV ? core::ColorSpace::kYuv : core::ColorSpace::kRgb;
+}
+
+}  // namespace
 
 bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::string* error) {
   core::PixelFormat format;
@@ -64,9 +71,7 @@ bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* e
     *error = "unknown color_space " + std::to_string(msg.color_space);
     return false;
   }
-  core::ColorLut out(msg.bits_per_channel, msg.color_space == act_color::ColorLut::COLOR_SPACE_YUV
-                                               ? core::ColorSpace::kYuv
-                                               : core::ColorSpace::kRgb);
+  core::ColorLut out(msg.bits_per_channel, colorSpace(msg));
   if (msg.table.size() != out.size()) {
     *error = "table has " + std::to_string(msg.table.size()) + " cells, expected " + std::to_string(out.size());
     return false;
@@ -95,6 +100,28 @@ bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* err
   out->y_m = p.y;
   out->theta_rad = std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
   return true;
+}
+
+sensor_msgs::ImagePtr newLabelsMsg(const sensor_msgs::Image& image, cv::Mat* labels) {
+  auto msg = boost::make_shared<sensor_msgs::Image>();
+  msg->header = image.header;
+  msg->height = image.height;
+  msg->width = image.width;
+  msg->encoding = "mono8";
+  msg->is_bigendian = 0;
+  msg->step = image.width;
+  msg->data.assign(static_cast<size_t>(image.width) * image.height, core::kUnknown);
+  *labels = cv::Mat(static_cast<int>(image.height), static_cast<int>(image.width), CV_8UC1, msg->data.data());
+  return msg;
+}
+
+core::LutView lutView(const act_color::ColorLut& msg) {
+  core::LutView view;
+  view.table = msg.table.data();
+  view.size = msg.table.size();
+  view.bits = msg.bits_per_channel;
+  view.space = colorSpace(msg);
+  return view;
 }
 
 sensor_msgs::ImagePtr labelsToMsg(const cv::Mat& labels, const std_msgs::Header& header) {

@@ -99,21 +99,9 @@ sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter
   ImageView v;
   std::string error;
   if (!conv::imageView(*image, &v, &error)) throw std::runtime_error(error);
-  auto labels_msg = boost::make_shared<sensor_msgs::Image>();
-  labels_msg->header = image->header;
-  labels_msg->height = image->height;
-  labels_msg->width = image->width;
-  labels_msg->encoding = "mono8";
-  labels_msg->step = image->width;
-  labels_msg->data.assign(static_cast<size_t>(image->width) * image->height, core::kUnknown);
-  cv::Mat labels(static_cast<int>(image->height), static_cast<int>(image->width), CV_8UC1, labels_msg->data.data());
-  core::LutView table;
-  table.table = lut->table.data();
-  table.size = lut->table.size();
-  table.bits = lut->bits_per_channel;
-  table.space =
-      lut->color_space == act_color::ColorLut::COLOR_SPACE_YUV ? core::ColorSpace::kYuv : core::ColorSpace::kRgb;
-  segmenter.classify(table, v, labels);
+  cv::Mat labels;
+  sensor_msgs::ImagePtr labels_msg = conv::newLabelsMsg(*image, &labels);
+  segmenter.classify(conv::lutView(*lut), v, labels);
   return labels_msg;
 }
 

@@ -24,13 +24,8 @@ namespace {
 constexpr int kAdaptationFrames = 12;
 
 struct RunResult {
-  core::ClassificationMetrics before;  // frames before the first light event (bootstrap frame excluded)
   core::ClassificationMetrics steady;  // all frames outside adaptation windows
-  core::ClassificationMetrics adapting;
-  std::vector<double> frame_fitness;
-  std::array<std::vector<double>, core::kNumClasses> frame_recall;  // per class, per frame
-  size_t event_frame = 0;                                           // first frame of the light change
-  core::RunEvaluation evaluation;  // act_replay's per-segment report of the same frames
+  core::RunEvaluation evaluation;      // per frame and per segment, as act_replay reports them
 };
 
 RunResult runAct(const std::string& name) {
@@ -41,7 +36,6 @@ RunResult runAct(const std::string& name) {
   const core::Segmenter segmenter(cal.camera);
   RunResult result;
   int since_event = 1 << 20;
-  bool seen_light_event = false;
   for (size_t i = 0; i < scenario.frames.size(); ++i) {
     const sim::ScenarioFrame& f = scenario.frames[i];
     const sim::LabeledFrame frame = renderer.render(f.scene);
@@ -53,23 +47,10 @@ RunResult runAct(const std::string& name) {
     segmenter.classify(trainer.lut(), view, labels);
     for (const std::string& e : f.events) {
       result.evaluation.markEvent(e);
-      if (e == "darken" || e == "brighten") {
-        since_event = 0;
-        seen_light_event = true;
-        result.event_frame = i;
-      }
+      if (e == "darken" || e == "brighten") since_event = 0;
     }
     result.evaluation.addFrame(labels, frame.labels);
-    core::ClassificationMetrics m;
-    m.add(labels, frame.labels);
-    result.frame_fitness.push_back(m.fitness(core::trainableClasses()));
-    for (int k = 0; k < core::kNumClasses; ++k) result.frame_recall[k].push_back(m.recall(k));
-    if (i > 0 && !seen_light_event) result.before.add(labels, frame.labels);
-    if (since_event < kAdaptationFrames) {
-      result.adapting.add(labels, frame.labels);
-    } else {
-      result.steady.add(labels, frame.labels);
-    }
+    if (since_event >= kAdaptationFrames) result.steady.add(labels, frame.labels);
     ++since_event;
   }
   std::printf("=== ACT on %s (small, %zu frames)\n", name.c_str(), scenario.frames.size());
@@ -83,7 +64,9 @@ RunResult runAct(const std::string& name) {
     std::printf("\n");
   }
   std::printf("fitness (eq. 6) per frame:");
-  for (double fit : result.frame_fitness) std::printf(" %.2f", fit);
+  for (size_t i = 0; i < result.evaluation.frames(); ++i) {
+    std::printf(" %.2f", result.evaluation.frame(i).fitness(core::trainableClasses()));
+  }
   std::printf("\n");
   return result;
 }

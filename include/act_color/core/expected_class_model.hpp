@@ -47,14 +47,11 @@ class ExpectedClassModel {
   // Distance from the robot to the nearest carpet edge or goal box (0 when outside the carpet).
   double safeCarpetRange(const Pose2D& pose) const;
 
-  // For the removal step (2.4): false when geometricClass(pixel_index) cannot be kUnknown, decided
-  // from one float per pixel (not imaged, chassis, or a floor point within safe_range_m).
-  bool mayBeOffField(size_t pixel_index, double safe_range_m) const {
-    return mayBeOffField(removal_range_m_[pixel_index], safe_range_m);
-  }
-  // The same from the pixel's removal range (for callers that keep a compact copy of them).
-  static bool mayBeOffField(float removal_range_m, double safe_range_m) { return !(removal_range_m < safe_range_m); }
+  // For the removal step (2.4): one float per pixel, -inf for pixels that are never kUnknown (not
+  // imaged, chassis), else the floor range. mayBeOffField is false when geometricClass cannot be
+  // kUnknown at a pose whose safeCarpetRange is safe_range_m.
   float removalRange(size_t pixel_index) const { return removal_range_m_[pixel_index]; }
+  static bool mayBeOffField(float removal_range_m, double safe_range_m) { return !(removal_range_m < safe_range_m); }
   size_t pixels() const { return removal_range_m_.size(); }
   // Hints the cache about a pixel the removal step will look at soon (no effect on results).
   void prefetchRemoval(size_t pixel_index) const {

@@ -9,6 +9,7 @@
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/color_lut.hpp"
 #include "act_color/core/image_view.hpp"
+#include "act_color/core/segmenter.hpp"
 #include "act_color/core/types.hpp"
 
 namespace act_color {
@@ -29,6 +30,13 @@ bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* err
 
 // mono8 label image message with the given header (copies the labels once).
 sensor_msgs::ImagePtr labelsToMsg(const cv::Mat& labels, const std_msgs::Header& header);
+
+// A mono8 labels message shaped like `image` (its header, every pixel kUnknown) and, in *labels,
+// a cv::Mat over the message's data: the labels are written straight into what is published.
+sensor_msgs::ImagePtr newLabelsMsg(const sensor_msgs::Image& image, cv::Mat* labels);
+
+// The table of a message, borrowed (no copy): valid while the message lives.
+core::LutView lutView(const act_color::ColorLut& msg);
 
 }  // namespace ros_conversions
 }  // namespace act_color

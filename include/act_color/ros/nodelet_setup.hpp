@@ -23,8 +23,9 @@ std::unique_ptr<diagnostic_updater::Updater> makeDiagnostics(
 // its whole manager with it.
 std::string runConfigure(const std::function<bool(std::string*)>& configure);
 
-// The calibration file named by ~calibration. False with the reason.
-bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* error);
+// The calibration file named by ~calibration (its path in *path). False with the reason.
+bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,
+                          std::string* error);
 
 }  // namespace ros_conversions
 }  // namespace act_color
