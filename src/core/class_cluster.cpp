@@ -6,6 +6,18 @@
 
 namespace act_color {
 namespace core {
+namespace {
+
+// For normally distributed colors (chi distribution, 3 degrees of freedom) the root mean square
+// distance from the mean, eq. 5's sigma, is 1.126 times the median distance and 0.804 times the
+// 80th percentile.
+constexpr double kRmsPerMedian = 1.126;
+constexpr double kRmsPerQuantile80 = 0.804;
+// A tail of colors (the 80th percentile) may widen sigma to at most this many times what the
+// median says: a minority of outliers (a robot in front of a goal) cannot take the cluster over.
+constexpr double kMaxTailGrowth = 3.0;
+
+}  // namespace
 
 void ClassCluster::reset(double max_value) {
   mean_ = Eigen::Vector3d::Constant(0.5 * max_value);  // eq. 2
@@ -58,10 +70,8 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
     std::vector<double> distance(colors.size());
     for (size_t i = 0; i < colors.size(); ++i) distance[i] = (colors[i].cast<double>() - median).norm();
     std::nth_element(distance.begin(), distance.begin() + distance.size() / 2, distance.end());
-    // For normally distributed colors the root mean square distance (eq. 5's sigma) is 1.126
-    // times the median distance (chi distribution, 3 degrees of freedom).
     mean_ = median;
-    sigma_ = std::max(1.126 * distance[distance.size() / 2], params.sigma_min);
+    sigma_ = std::max(kRmsPerMedian * distance[distance.size() / 2], params.sigma_min);
     last_samples_ = static_cast<unsigned>(colors.size());
     trained_ = true;
     return last_samples_;
@@ -86,8 +96,12 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
   // cannot blow the cluster up.
   distances_.clear();
   for (const auto& c : colors) distances_.push_back((c.cast<double>() - mean_).norm());
-  std::nth_element(distances_.begin(), distances_.begin() + distances_.size() / 2, distances_.end());
-  const double spread = std::min(1.126 * distances_[distances_.size() / 2], 2.0 * sigma_);
+  const size_t q80 = distances_.size() * 4 / 5, q50 = distances_.size() / 2;
+  std::nth_element(distances_.begin(), distances_.begin() + q80, distances_.end());
+  std::nth_element(distances_.begin(), distances_.begin() + q50, distances_.begin() + q80);
+  const double by_median = kRmsPerMedian * distances_[q50];
+  const double by_q80 = std::min(kRmsPerQuantile80 * distances_[q80], kMaxTailGrowth * by_median);
+  const double spread = std::min(std::max(by_median, by_q80), 2.0 * sigma_);
   sigma_ = std::max((params.eta * sigma_ + spread) / (params.eta + 1.0), params.sigma_min);
   last_samples_ = static_cast<unsigned>(inliers_.size());
   return last_samples_;

@@ -41,8 +41,10 @@ class ClassCluster {
   // Extension (ActParams::robust_clusters) for classes whose expected pixels may show something
   // else (a robot in front of a goal, a wrong pose): an untrained cluster is seeded from the
   // per-channel median and the median distance; a trained one moves its mean by eq. 4 towards the
-  // colors within zeta * sigma (at least two) and its sigma by eq. 5 towards the median spread of
-  // all colors (at most twice sigma), without doubling. Returns the inliers used.
+  // colors within zeta * sigma (at least two) and its sigma by eq. 5 towards the spread of all
+  // colors (the larger of the estimates from the median and from the 80th percentile distance, the
+  // latter at most 3 times the former, and at most twice sigma), without doubling. Returns the
+  // inliers used.
   unsigned updateFromInliers(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
 
   // A global change of light, modelled as per-channel gains about a pivot (0 for R, G, B and Y;
