@@ -19,6 +19,9 @@ void requireRange(const char* name, double value, double lo, double hi, bool lo_
   }
 }
 
+// Weight of the intensity difference in the nearest-mean rule (ActParams::nearest_mean).
+constexpr double kIntensityWeight = 0.1;
+
 // Largest ratio between the per-channel gains of a change of light (see cycle()).
 constexpr double kMaxGainSpread = 2.5;
 
@@ -36,6 +39,7 @@ void ActParams::validate() const {
   requireRange("add_neighbourhood_cells", add_neighbourhood_cells, 0, 3);
   requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
   requireRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
+  requireRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
 }
 
 void ActParams::switchOffExtensions() {
@@ -45,6 +49,8 @@ void ActParams::switchOffExtensions() {
   light_compensation = false;
   removal_protect_cycles = 0;
   robots_train_black = false;
+  nearest_mean = false;
+  evidence_removal_ratio = 0;
 }
 
 ActParams ActParams::paper() {
@@ -64,6 +70,7 @@ void ActTrainer::reset(ColorSpace space) {
   lut_ = ColorLut(params_.lut_bits, space);
   confirmed_.assign(lut_.size(), 0);
   neighbour_only_.assign(lut_.size(), 0);
+  evidence_.assign(lut_.size(), Evidence{});
   for (auto& cluster : clusters_) cluster.reset(255.0);
   space_known_ = true;
 }
@@ -89,6 +96,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   lut_ = lut;
   confirmed_.assign(lut_.size(), 0);
   neighbour_only_.assign(lut_.size(), 0);
+  evidence_.assign(lut_.size(), Evidence{});
   space_known_ = true;
 }
 
@@ -109,9 +117,20 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   uint32_t changed = 0;
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
   if (params_.robust_clusters && claimedByOtherClass(color, lut_.at(cell), k)) return 0;
+  if (nearerToOtherMean(color, k)) return 0;
   // A cell sampled for k before in this cycle has had its neighbourhood filled with this very
   // cluster: doing it again changes nothing.
   const uint32_t this_cycle = static_cast<uint32_t>(revision_ + 1);
+  if (params_.evidence_removal_ratio > 0) {
+    // The counts stay when a cell is removed and comes back: a color seen more often off the
+    // field than in it is not added again by one in-field sample. They restart when the cell
+    // goes from one class to another.
+    Evidence& e = evidence(cell);
+    const uint8_t current = lut_.at(cell);
+    if (current != k && current != kUnknown) e = Evidence{0.f, 0.f, this_cycle};
+    e.in_field += static_cast<float>(add_weight_);
+    if (current != k && e.off_field > params_.evidence_removal_ratio * e.in_field) return 0;
+  }
   if (confirmed_[cell] == this_cycle && lut_.at(cell) == k) return 0;
   confirmed_[cell] = this_cycle;
   neighbour_only_[cell] = 0;
@@ -136,8 +155,10 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
         const double distance = (cluster.mean() - centre).norm();
         if (distance >= radius) continue;
         if (claimedByOtherClass(centre, current, k)) continue;
+        if (nearerToOtherMean(centre, k)) continue;
         lut_.set(neighbour, k);
         neighbour_only_[neighbour] = 1;
+        if (params_.evidence_removal_ratio > 0) evidence_[neighbour] = Evidence{0.f, 0.f, this_cycle};
         ++changed;
       }
     }
@@ -155,6 +176,25 @@ uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
   if (intensity >= 0.6 * green.mean().sum() || hi - lo > 0.35 * hi + 8) return k;
   const Eigen::Vector3d color(c[0], c[1], c[2]);
   return (color - green.mean()).norm() > params_.zeta * green.sigma() ? static_cast<uint8_t>(kBlack) : k;
+}
+
+bool ActTrainer::nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const {
+  if (!params_.nearest_mean) return false;
+  const bool yuv = lut_.colorSpace() == ColorSpace::kYuv;
+  // Squared distance with the intensity difference weighted by kIntensityWeight: a line in a
+  // shadow stays nearer to white than to green, a mixture of two classes is split at its middle.
+  auto distanceSq = [&](const Eigen::Vector3d& mean) {
+    const Eigen::Vector3d d = color - mean;
+    if (yuv) return kIntensityWeight * d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    const double intensity = d.sum() / 3.0;
+    return d.squaredNorm() - 3.0 * (1.0 - kIntensityWeight) * intensity * intensity;
+  };
+  const double own = distanceSq(clusters_[k].mean());
+  for (int j = 1; j < kNumClasses; ++j) {
+    if (j == k || !clusters_[j].trained()) continue;
+    if (distanceSq(clusters_[j].mean()) < own) return true;
+  }
+  return false;
 }
 
 bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const {
@@ -178,6 +218,7 @@ void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vect
   const double width = 1 << (8 - bits);
   warped_.assign(lut_.table().begin(), lut_.table().end());
   warped_neighbour_only_.assign(neighbour_only_.begin(), neighbour_only_.end());
+  warped_evidence_.assign(evidence_.begin(), evidence_.end());
   const uint32_t mask = (1u << bits) - 1;
   for (uint32_t cell = 0; cell < lut_.size(); ++cell) {
     const uint8_t k = lut_.at(cell);
@@ -201,15 +242,36 @@ void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vect
           const uint32_t target = (static_cast<uint32_t>(a) << (2 * bits)) | (static_cast<uint32_t>(b) << bits) | d;
           warped_[target] = k;
           warped_neighbour_only_[target] = neighbour_only_[cell];
+          warped_evidence_[target] = evidence_[cell];
         }
       }
     }
   }
   lut_.assign(warped_);
   neighbour_only_.swap(warped_neighbour_only_);
+  // The counts move with their cells: colors seen in the field stay so under the new light.
+  evidence_.swap(warped_evidence_);
   // Confirmations were made under the old light: colors of the old light that now show up off the
   // field must not be protected from removal.
   std::fill(confirmed_.begin(), confirmed_.end(), 0u);
+}
+
+ActTrainer::Evidence& ActTrainer::evidence(uint32_t cell) {
+  static const std::array<float, kEvidenceMemory> decay = [] {
+    std::array<float, kEvidenceMemory> d{};
+    for (size_t n = 0; n < d.size(); ++n) d[n] = static_cast<float>(std::pow(0.5, n / kEvidenceHalfLifeCycles));
+    return d;
+  }();
+  Evidence& e = evidence_[cell];
+  const uint32_t now = static_cast<uint32_t>(revision_ + 1);
+  const uint32_t age = now - e.stamp;
+  if (age != 0) {
+    const float f = age < decay.size() ? decay[age] : 0.f;
+    e.in_field *= f;
+    e.off_field *= f;
+    e.stamp = now;
+  }
+  return e;
 }
 
 void ActTrainer::checkImage(const ImageView& image) const {
@@ -321,6 +383,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
   const int add_stride =
       stats.light_change ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
+  add_weight_ = add_stride;
   for (size_t i = randomStart(add_stride); i < pixels; i += add_stride) {
     const uint8_t k = expected(i);
     if (k == kUnknown || k >= kNumClasses) continue;
@@ -382,6 +445,18 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     if (k == kUnknown || k >= kNumClasses) continue;
     if (!model_.offField(i, transform)) continue;
     ++stats.remove_candidates;
+    if (params_.evidence_removal_ratio > 0) {
+      Evidence& e = evidence(cell);
+      e.off_field += static_cast<float>(params_.remove_stride);
+      if (e.off_field >= kMinOffFieldSightings * params_.remove_stride &&
+          e.off_field > params_.evidence_removal_ratio * e.in_field) {
+        lut_.set(cell, kUnknown);
+        neighbour_only_[cell] = 0;
+        confirmed_[cell] = 0;
+        ++stats.removed[k];
+        continue;
+      }
+    }
     if (confirmed_[cell] != 0 &&
         revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
       continue;

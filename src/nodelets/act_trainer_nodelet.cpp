@@ -127,6 +127,8 @@ bool ActTrainerNodelet::configure(std::string* error) {
   params.light_change_add_stride = pnh_.param("light_change_add_stride", params.light_change_add_stride);
   params.removal_protect_cycles = pnh_.param("removal_protect_cycles", params.removal_protect_cycles);
   params.robots_train_black = pnh_.param("robots_train_black", params.robots_train_black);
+  params.nearest_mean = pnh_.param("nearest_mean", params.nearest_mean);
+  params.evidence_removal_ratio = pnh_.param("evidence_removal_ratio", params.evidence_removal_ratio);
   try {
     params.validate();
   } catch (const std::exception& e) {

@@ -24,6 +24,9 @@ void printUsage(std::ostream& out) {
          "  --paper              the paper's algorithm exactly (every extension off)\n"
          "  --neighbourhood-cells N  an added color also adds cells within n cells (default 1)\n"
          "  --removal-protect-cycles N  cells confirmed in the field within n cycles are not removed (default 10)\n"
+         "  --evidence-removal-ratio X  cells seen off the field X times as often as in it are removed (default 3, 0 "
+         "off)\n"
+         "  --no-nearest-mean    add colors to their class even when another class's mean is nearer\n"
          "  --bootstrap-cycles N cycles on the first image with a pose (default 100)\n"
          "  --lut-every N        write /act/color_lut with every n-th frame (default 1)\n"
          "  --adapt-frames N     frames after each event left out of the *_ad figures (default 12)\n"
@@ -90,6 +93,10 @@ int main(int argc, char** argv) {
         p.add_neighbourhood_cells = integer();
       } else if (arg == "--removal-protect-cycles") {
         p.removal_protect_cycles = integer();
+      } else if (arg == "--evidence-removal-ratio") {
+        p.evidence_removal_ratio = number();
+      } else if (arg == "--no-nearest-mean") {
+        p.nearest_mean = false;
       } else if (arg == "--bootstrap-cycles") {
         options.bootstrap_cycles = integer();
       } else if (arg == "--lut-every") {

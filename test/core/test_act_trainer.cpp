@@ -115,6 +115,7 @@ TEST_F(ActTrainerTest, RemovalExaminesEveryTwentiethOffFieldPixel) {
   for (uint32_t cell = 0; cell < all_green.size(); ++cell) all_green.set(cell, kGreen);
   ActParams p;
   p.xi = 100.0;
+  p.evidence_removal_ratio = 0;  // would remove cells within the cycle, and they would count less
   ActTrainer trainer(cal, p);
   trainer.loadTable(all_green);
   const CycleStats s = trainer.cycle(view(frame.rgb), near_corner);
@@ -154,6 +155,7 @@ TEST_F(ActTrainerTest, AddsOnlyColorsWithinZetaSigma) {
   // With a huge zeta the threshold no longer filters: the outlier color gets added.
   ActParams p;
   p.zeta = 50.0;
+  p.nearest_mean = false;  // magenta is nearer to the (neutral) white and black means than to green
   ActTrainer loose(cal, p);
   loose.bootstrap(view(frame.rgb), pose, 40);
   EXPECT_EQ(loose.lut().classOf(200, 40, 200), kGreen);
@@ -162,7 +164,9 @@ TEST_F(ActTrainerTest, AddsOnlyColorsWithinZetaSigma) {
 TEST_F(ActTrainerTest, RemovesOffFieldColorsBeyondXiSigma) {
   const Pose2D near_corner{7.5, 4.5, 0.0};
   auto frame = paintFlatFrame(model, near_corner, 1.0, 1);
-  ActTrainer trainer(cal);
+  ActParams paper_removal;
+  paper_removal.evidence_removal_ratio = 0;  // the color near green is seen off the field often
+  ActTrainer trainer(cal, paper_removal);
   trainer.bootstrap(view(frame.rgb), near_corner, 30);
   const auto& green = trainer.clusters()[kGreen];
   const Eigen::Vector3d mean = green.mean();
@@ -189,7 +193,7 @@ TEST_F(ActTrainerTest, RemovesOffFieldColorsBeyondXiSigma) {
   EXPECT_EQ(trainer.lut().classOf(150, 60, 90), kUnknown);
   EXPECT_EQ(trainer.lut().classOf(near[0], near[1], near[2]), kGreen);
   // With a huge xi nothing is removed.
-  ActParams p;
+  ActParams p = paper_removal;
   p.xi = 50.0;
   ActTrainer keep(cal, p);
   keep.loadTable(lut);
@@ -202,7 +206,8 @@ TEST_F(ActTrainerTest, NeighbourCellsSeenOffTheFieldAreRemovedWhateverTheirDista
   auto frame = paintFlatFrame(model, near_corner, 1.0, 1);
   ActParams p;
   p.removal_protect_cycles = 0;
-  p.xi = 50.0;  // every green cell lies within xi * sigma: 2.4 alone would remove nothing
+  p.evidence_removal_ratio = 0;  // the confirmed cell is seen off the field often
+  p.xi = 50.0;                   // every green cell lies within xi * sigma: 2.4 alone would remove nothing
   ActTrainer trainer(cal, p);
   trainer.bootstrap(view(frame.rgb), near_corner, 30);
   const ClassCluster& green = trainer.clusters()[kGreen];
@@ -351,4 +356,99 @@ TEST_F(ActTrainerTest, ANewColorSpaceStartsAFreshTable) {
   const CycleStats s = trainer.cycle(ImageView::fromMat(uyvy, PixelFormat::kUyvy), pose);
   EXPECT_TRUE(s.color_space_changed);
   EXPECT_EQ(trainer.lut().colorSpace(), ColorSpace::kYuv);
+}
+
+namespace {
+
+cv::Vec3b mix(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double share_of_a) {
+  const Eigen::Vector3d c = share_of_a * a + (1.0 - share_of_a) * b;
+  return cv::Vec3b(static_cast<uint8_t>(std::lround(c[0])), static_cast<uint8_t>(std::lround(c[1])),
+                   static_cast<uint8_t>(std::lround(c[2])));
+}
+
+}  // namespace
+
+TEST_F(ActTrainerTest, MixedColorsJoinTheClassWhoseMeanIsNearer) {
+  // Trained on the clean frame; then the line pixels show, in turn, a mixture that is 35% white
+  // and 65% green (a blurred line edge, mostly carpet), one that is 65% white, and a shadowed
+  // white (60% of white's intensity, neutral). With a zeta that lets all of them into white's
+  // sphere, every line pixel added, and the clusters frozen, only the nearest-mean rule decides.
+  const auto clean = paintFlatFrame(model, pose, 1.0, 1);
+  ActParams p;
+  p.add_neighbourhood_cells = 0;
+  ActTrainer trainer(cal, p);
+  trainer.bootstrap(view(clean.rgb), pose, 40);
+  const Eigen::Vector3d white = trainer.clusters()[kWhite].mean(), green = trainer.clusters()[kGreen].mean();
+  const cv::Vec3b mostly_green = mix(white, green, 0.35), mostly_white = mix(white, green, 0.65);
+  const cv::Vec3b shadow = mix(white, Eigen::Vector3d::Zero(), 0.6);
+  for (const cv::Vec3b& c : {mostly_green, mostly_white, shadow}) {
+    ASSERT_EQ(trainer.lut().classOf(c[0], c[1], c[2]), kUnknown) << c;
+  }
+  cv::Mat frame = clean.rgb.clone();
+  const PoseTransform t(pose);
+  const cv::Vec3b colors[3] = {mostly_green, mostly_white, shadow};
+  int n = 0;
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      if (model.geometricClass(v * 580 + u, t) == kWhite) frame.at<cv::Vec3b>(v, u) = colors[n++ % 3];
+    }
+  }
+  auto trainOnce = [&](bool nearest_mean) {
+    ActTrainer copy = trainer;
+    ActParams q = p;
+    q.zeta = 40.0;
+    q.white_filter = false;
+    q.add_stride = 1;
+    q.cluster_stride = 1 << 20;  // no cluster update: the means stay those of the clean frame
+    q.remove_stride = 1 << 20;
+    q.nearest_mean = nearest_mean;
+    copy.setParams(q);
+    copy.cycle(view(frame), pose);
+    return copy.lut();
+  };
+  const ColorLut with = trainOnce(true);
+  EXPECT_NE(with.classOf(mostly_green[0], mostly_green[1], mostly_green[2]), kWhite);
+  EXPECT_EQ(with.classOf(mostly_white[0], mostly_white[1], mostly_white[2]), kWhite);
+  EXPECT_EQ(with.classOf(shadow[0], shadow[1], shadow[2]), kWhite);  // neutral: nearer white than green
+  // Without the rule zeta alone decides: the mostly-green mixture becomes white.
+  const ColorLut without = trainOnce(false);
+  EXPECT_EQ(without.classOf(mostly_green[0], mostly_green[1], mostly_green[2]), kWhite);
+}
+
+TEST_F(ActTrainerTest, ColorsSeenMoreOftenOffTheFieldThanInItAreRemovedWithinXiSigma) {
+  // Green's own mean color painted over most of what lies off the carpet: by 2.4 alone (within
+  // xi sigma) and by the protection of recently confirmed cells it stays green. Seen off the field
+  // far more often than in it, the evidence rule removes it; painted on a small patch only, the
+  // carpet's own pixels outweigh it and it stays.
+  const Pose2D near_corner{7.5, 4.5, 0.0};
+  const auto clean = paintFlatFrame(model, near_corner, 1.0, 1);
+  const PoseTransform t(near_corner);
+  auto run = [&](int every_nth_row, double ratio) {
+    ActParams p;
+    p.evidence_removal_ratio = ratio;
+    ActTrainer trainer(cal, p);
+    trainer.bootstrap(view(clean.rgb), near_corner, 30);
+    const Eigen::Vector3d m = trainer.clusters()[kGreen].mean();
+    const cv::Vec3b mean(static_cast<uint8_t>(m[0]), static_cast<uint8_t>(m[1]), static_cast<uint8_t>(m[2]));
+    EXPECT_EQ(trainer.lut().classOf(mean[0], mean[1], mean[2]), kGreen);
+    cv::Mat frame = clean.rgb.clone();
+    int painted = 0;
+    for (int v = 0; v < 580; v += every_nth_row) {
+      for (int u = 0; u < 580; ++u) {
+        if (model.geometricClass(v * 580 + u, t) == kUnknown) {
+          frame.at<cv::Vec3b>(v, u) = mean;
+          ++painted;
+        }
+      }
+    }
+    for (int i = 0; i < 10; ++i) trainer.cycle(view(frame), near_corner);
+    return std::make_pair(trainer.lut().classOf(mean[0], mean[1], mean[2]), painted);
+  };
+  const auto everywhere = run(1, 3.0);
+  EXPECT_GT(everywhere.second, 50000);
+  EXPECT_EQ(everywhere.first, kUnknown);
+  EXPECT_EQ(run(1, 0.0).first, kGreen);  // the rule off: the paper's removal keeps it
+  const auto patch = run(60, 3.0);
+  EXPECT_LT(patch.second, 2500);
+  EXPECT_EQ(patch.first, kGreen);
 }

@@ -62,6 +62,16 @@ struct ActParams {
   // zeta * sigma), dark (intensity below 60% of green's) and unsaturated is a robot standing on
   // the carpet and trains black instead.
   bool robots_train_black = true;
+  // A color joins class k only when k's cluster mean is the nearest of the trained clusters'
+  // means: the table splits mixed colors (the blurred edge of a line on the carpet) where they are
+  // half one class and half the other, not at zeta * sigma of the wider cluster.
+  bool nearest_mean = true;
+  // Each table cell counts, with a half-life of kEvidenceHalfLifeCycles, the pixels estimated to
+  // show its color in the field as its class (in-field samples x add stride) and off the field
+  // (off-field samples x remove_stride). A cell whose off-field count exceeds this many times its
+  // in-field count is removed whatever its distance from the cluster: the color is more often
+  // something else than the class (a spot-lit whitish hall floor next to white). 0: off.
+  double evidence_removal_ratio = 3.0;
 
   void validate() const;
   // Every extension off: the paper's algorithm exactly.
@@ -119,11 +129,23 @@ class ActTrainer {
   uint32_t addColor(const uint8_t c[3], uint8_t k);
   // True when the color is mapped to a trained class other than k and is nearer to that class's
   // cluster than to k's, in units of sigma.
+  bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
   // The class a sample expected as k trains (robots_train_black re-routes green to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
   // Light compensation: gains to every cluster, table cells moved by the gains.
   void applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot);
+
+  struct Evidence {
+    float in_field = 0.f;
+    float off_field = 0.f;
+    uint32_t stamp = 0;  // cycle up to which the counts are decayed
+  };
+  static constexpr double kEvidenceHalfLifeCycles = 20.0;
+  static constexpr size_t kEvidenceMemory = 256;  // cycles after which counts are 0
+  static constexpr int kMinOffFieldSightings = 3;
+  // The cell's counts, decayed to this cycle.
+  Evidence& evidence(uint32_t cell);
 
   ExpectedClassModel model_;
   ActParams params_;
@@ -140,6 +162,9 @@ class ActTrainer {
   // 1 for cells mapped by add_neighbourhood_cells and not yet seen in the field themselves.
   std::vector<uint8_t> neighbour_only_;
   std::vector<uint8_t> warped_neighbour_only_;
+  std::vector<Evidence> evidence_;
+  std::vector<Evidence> warped_evidence_;
+  int add_weight_ = 1;  // pixels one in-field sample stands for in this cycle
   // The removal step's samples start, start + remove_stride, ... that can ever be off the field,
   // with their removal range (ExpectedClassModel::removalRange), farthest first: the samples that
   // may be off the field at a pose are a prefix (range >= safeCarpetRange). Built for each start
