@@ -136,12 +136,17 @@ TEST_F(ActTrainerTest, WhiteIsTrainedOnlyFromPixelsBrighterThanTheirNeighbourhoo
 
 TEST_F(ActTrainerTest, AddsOnlyColorsWithinZetaSigma) {
   auto frame = paintFlatFrame(model, pose, 1.0, 1);
-  // A magenta patch on the carpet, expected green: far outside the green cluster.
+  // Magenta specks on a tenth of the carpet, expected green: far outside the green cluster. The
+  // specks are scattered by a hash: a pattern periodic in the pixel index (every 10th column)
+  // would meet every sample of a cycle whose random start falls on it (strides 400 and 580 are
+  // multiples of 10), and such a cycle trains the clusters and adds from magenta alone.
   const PoseTransform t(pose);
   int patch = 0;
   for (int v = 0; v < 580; ++v) {
     for (int u = 0; u < 580; ++u) {
-      if (u % 10 == 0 && frame.labels.at<uint8_t>(v, u) == kGreen && model.geometricClass(v * 580 + u, t) == kGreen) {
+      const uint32_t hash = static_cast<uint32_t>(v * 580 + u) * 2654435761u;
+      if ((hash >> 16) % 10 == 0 && frame.labels.at<uint8_t>(v, u) == kGreen &&
+          model.geometricClass(v * 580 + u, t) == kGreen) {
         frame.rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(200, 40, 200);
         ++patch;
       }
