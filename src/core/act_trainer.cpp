@@ -22,6 +22,9 @@ void requireRange(const char* name, double value, double lo, double hi, bool lo_
 // Weight of the intensity difference in the nearest-mean rule (ActParams::nearest_mean).
 constexpr double kIntensityWeight = 0.1;
 
+// A cell confirmed again within this many cycles does not fill its neighbourhood again.
+constexpr uint32_t kNeighbourhoodRefreshCycles = 8;
+
 // Largest ratio between the per-channel gains of a change of light (see cycle()).
 constexpr double kMaxGainSpread = 2.5;
 
@@ -68,6 +71,7 @@ ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
 
 void ActTrainer::reset(ColorSpace space) {
   lut_ = ColorLut(params_.lut_bits, space);
+  rebuildMapped();
   confirmed_.assign(lut_.size(), 0);
   neighbour_only_.assign(lut_.size(), 0);
   evidence_.assign(lut_.size(), Evidence{});
@@ -94,6 +98,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
                                 " bits per channel, lut_bits is " + std::to_string(params_.lut_bits));
   }
   lut_ = lut;
+  rebuildMapped();
   confirmed_.assign(lut_.size(), 0);
   neighbour_only_.assign(lut_.size(), 0);
   evidence_.assign(lut_.size(), Evidence{});
@@ -131,15 +136,20 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     e.in_field += static_cast<float>(add_weight_);
     if (current != k && e.off_field > params_.evidence_removal_ratio * e.in_field) return 0;
   }
-  if (confirmed_[cell] == this_cycle && lut_.at(cell) == k) return 0;
+  const uint32_t last_confirmed = confirmed_[cell];
+  const bool was_k = lut_.at(cell) == k;
+  if (last_confirmed == this_cycle && was_k) return 0;
   confirmed_[cell] = this_cycle;
   neighbour_only_[cell] = 0;
-  if (lut_.at(cell) != k) {
-    lut_.set(cell, k);
+  if (!was_k) {
+    setCell(cell, k);
     ++changed;
   }
   const int n = params_.add_neighbourhood_cells;
   if (n == 0) return changed;
+  // The neighbourhood of a cell confirmed in the last few cycles was filled with a cluster that
+  // has hardly moved since (eta = 4): it is filled again only every kNeighbourhoodRefreshCycles.
+  if (was_k && last_confirmed != 0 && this_cycle - last_confirmed < kNeighbourhoodRefreshCycles) return changed;
   const int bits = lut_.bitsPerChannel();
   const int shift = 8 - bits;
   const int cells = 1 << bits;
@@ -156,7 +166,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
         if (distance >= radius) continue;
         if (claimedByOtherClass(centre, current, k)) continue;
         if (nearerToOtherMean(centre, k)) continue;
-        lut_.set(neighbour, k);
+        setCell(neighbour, k);
         neighbour_only_[neighbour] = 1;
         if (params_.evidence_removal_ratio > 0) evidence_[neighbour] = Evidence{0.f, 0.f, this_cycle};
         ++changed;
@@ -248,12 +258,30 @@ void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vect
     }
   }
   lut_.assign(warped_);
+  rebuildMapped();
   neighbour_only_.swap(warped_neighbour_only_);
   // The counts move with their cells: colors seen in the field stay so under the new light.
   evidence_.swap(warped_evidence_);
   // Confirmations were made under the old light: colors of the old light that now show up off the
   // field must not be protected from removal.
   std::fill(confirmed_.begin(), confirmed_.end(), 0u);
+}
+
+void ActTrainer::setCell(uint32_t cell, uint8_t k) {
+  lut_.set(cell, k);
+  const uint64_t bit = uint64_t{1} << (cell & 63);
+  if (k == kUnknown) {
+    mapped_[cell >> 6] &= ~bit;
+  } else {
+    mapped_[cell >> 6] |= bit;
+  }
+}
+
+void ActTrainer::rebuildMapped() {
+  mapped_.assign((lut_.size() + 63) / 64, 0);
+  for (uint32_t cell = 0; cell < lut_.size(); ++cell) {
+    if (lut_.at(cell) != kUnknown) mapped_[cell >> 6] |= uint64_t{1} << (cell & 63);
+  }
 }
 
 ActTrainer::Evidence& ActTrainer::evidence(uint32_t cell) {
@@ -394,9 +422,18 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
-  const double safe_range = model_.safeCarpetRange(pose);
   const size_t start = randomStart(params_.remove_stride);
-  const std::vector<RemovalSample>& samples = removalSamples(start);
+  const RemovalSamples& samples = removalSamples(start);
+  // The samples that may be off the field: in each sector of bearings, a prefix of its list.
+  model_.sectorSafeRanges(pose, sector_safe_range_);
+  candidates_.clear();
+  for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
+    const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
+    for (uint32_t j = samples.sector_begin[sector]; j < samples.sector_begin[sector + 1]; ++j) {
+      if (!ExpectedClassModel::mayBeOffField(samples.samples[j].range_m, safe_range)) break;
+      candidates_.push_back(samples.samples[j].pixel);
+    }
+  }
   const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
   // Row and column without a division (exact for any image of less than 2^26 pixels).
   const double inverse_width = 1.0 / width;
@@ -416,18 +453,12 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     const double radius = params_.xi * clusters_[k].sigma();
     remove_radius_sq[k] = static_cast<float>(radius * radius);
   }
-  // The samples that may be off the field: a prefix of the list.
-  const size_t candidates =
-      static_cast<size_t>(std::partition_point(samples.begin(), samples.end(),
-                                               [&](const RemovalSample& s) {
-                                                 return ExpectedClassModel::mayBeOffField(s.range_m, safe_range);
-                                               }) -
-                          samples.begin());
   // They lie far apart in memory: fetch their ray and pixel some samples ahead.
   constexpr size_t kAhead = 16;
+  const size_t candidates = candidates_.size();
   for (size_t j = 0; j < candidates; ++j) {
     if (j + kAhead < candidates) {
-      const size_t ahead = samples[j + kAhead].pixel;
+      const size_t ahead = candidates_[j + kAhead];
       size_t v, u;
       rowColumn(ahead, v, u);
       model_.prefetchRemoval(ahead);
@@ -435,14 +466,15 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     }
     // The color first: most colors seen off the field are mapped to no class, and then whether
     // the pixel really is off the field (a ray cast) does not matter.
-    const size_t i = samples[j].pixel;
+    const size_t i = candidates_[j];
     size_t v, u;
     rowColumn(i, v, u);
     uint8_t c[3];
     image.color(static_cast<int>(u), static_cast<int>(v), c);
     const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+    if (!mapped(cell)) continue;  // the bitmap fits the L1 cache, the table does not
     const uint8_t k = lut_.at(cell);
-    if (k == kUnknown || k >= kNumClasses) continue;
+    if (k >= kNumClasses) continue;
     if (!model_.offField(i, transform)) continue;
     ++stats.remove_candidates;
     if (params_.evidence_removal_ratio > 0) {
@@ -450,7 +482,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       e.off_field += static_cast<float>(params_.remove_stride);
       if (e.off_field >= kMinOffFieldSightings * params_.remove_stride &&
           e.off_field > params_.evidence_removal_ratio * e.in_field) {
-        lut_.set(cell, kUnknown);
+        setCell(cell, kUnknown);
         neighbour_only_[cell] = 0;
         confirmed_[cell] = 0;
         ++stats.removed[k];
@@ -463,7 +495,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     }
     if (neighbour_only_[cell] ||
         (remove_mean[k] - Eigen::Vector3f(c[0], c[1], c[2])).squaredNorm() > remove_radius_sq[k]) {
-      lut_.set(cell, kUnknown);
+      setCell(cell, kUnknown);
       neighbour_only_[cell] = 0;
       ++stats.removed[k];
     }
@@ -472,23 +504,38 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   return stats;
 }
 
-const std::vector<ActTrainer::RemovalSample>& ActTrainer::removalSamples(size_t start) {
+const ActTrainer::RemovalSamples& ActTrainer::removalSamples(size_t start) {
   if (removal_samples_stride_ != params_.remove_stride) {
     removal_samples_.clear();
     removal_samples_stride_ = params_.remove_stride;
   }
   auto [it, inserted] = removal_samples_.try_emplace(start);
   if (inserted) {
-    std::vector<RemovalSample>& samples = it->second;
+    struct Entry {
+      int sector;
+      RemovalSample sample;
+    };
+    std::vector<Entry> entries;
     const size_t stride = static_cast<size_t>(params_.remove_stride);
     for (size_t i = start; i < model_.pixels(); i += stride) {
       const float range = model_.removalRange(i);
       if (range > -std::numeric_limits<float>::infinity()) {  // can be off the field at some pose
-        samples.push_back({static_cast<uint32_t>(i), range});
+        entries.push_back({model_.removalSector(i), {static_cast<uint32_t>(i), range}});
       }
     }
-    std::stable_sort(samples.begin(), samples.end(),
-                     [](const RemovalSample& a, const RemovalSample& b) { return a.range_m > b.range_m; });
+    // By sector, farthest first within each; the order does not change the table.
+    std::stable_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+      return a.sector != b.sector ? a.sector < b.sector : a.sample.range_m > b.sample.range_m;
+    });
+    RemovalSamples& list = it->second;
+    list.sector_begin.fill(0);
+    for (const Entry& e : entries) {
+      list.samples.push_back(e.sample);
+      ++list.sector_begin[static_cast<size_t>(e.sector) + 1];
+    }
+    for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
+      list.sector_begin[sector + 1] += list.sector_begin[sector];
+    }
   }
   return it->second;
 }

@@ -1,6 +1,7 @@
 #include "act_color/core/expected_class_model.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace act_color {
@@ -76,6 +77,52 @@ double ExpectedClassModel::safeCarpetRange(const Pose2D& pose) const {
   const double dy = std::max(0.0, ay - f.goal_width_m / 2);
   range = std::min(range, std::hypot(dx, dy));
   return std::max(0.0, range);
+}
+
+int ExpectedClassModel::removalSector(size_t pixel_index) const {
+  const PixelRay& ray = camera_.ray(pixel_index);
+  constexpr double kTwoPi = 2.0 * M_PI;
+  double bearing = std::atan2(static_cast<double>(ray.dir_y), static_cast<double>(ray.dir_x));
+  if (bearing < 0) bearing += kTwoPi;
+  const int sector = static_cast<int>(bearing / kTwoPi * kRemovalSectors);
+  return std::clamp(sector, 0, kRemovalSectors - 1);
+}
+
+void ExpectedClassModel::sectorSafeRanges(const Pose2D& pose, std::array<double, kRemovalSectors>& out) const {
+  // Off the carpet or in a goal region means |x| >= half length (the goal lines; goals lie behind
+  // them, and a ray to a floor point in front of them cannot pass through a goal) or |y| >= half
+  // width + margin. Along a ray at angle a the wall with inner normal angle n and distance d is
+  // reached after d / cos(a - n); over a sector the smallest is at the bearing nearest to n.
+  const double x_wall = field_.halfLength();
+  const double y_wall = field_.halfWidth() + field_.calibration().margin_m;
+  if (!(std::abs(pose.x_m) < x_wall && std::abs(pose.y_m) < y_wall)) {
+    out.fill(0.0);
+    return;
+  }
+  // Inner normals along +x, -x, +y, -y, and the distances to the walls.
+  const double distance[4] = {x_wall - pose.x_m, x_wall + pose.x_m, y_wall - pose.y_m, y_wall + pose.y_m};
+  const double half = M_PI / kRemovalSectors;  // half a sector
+  const double cos_half = std::cos(half), sin_half = std::sin(half);
+  // cos and sin of the sector centres, by rotating from the first one.
+  double c = std::cos(pose.theta_rad + half), sn = std::sin(pose.theta_rad + half);
+  const double cos_step = std::cos(2.0 * half), sin_step = std::sin(2.0 * half);
+  for (int s = 0; s < kRemovalSectors; ++s) {
+    // cos and |sin| of the angle between each normal and the sector centre.
+    const double cos_delta[4] = {c, -c, sn, -sn};
+    const double sin_delta[4] = {std::abs(sn), std::abs(sn), std::abs(c), std::abs(c)};
+    double safe = std::numeric_limits<double>::infinity();
+    for (int w = 0; w < 4; ++w) {
+      // cos of the angle to the sector's nearest bearing: 1 when the normal lies in the sector.
+      const double cos_nearest = cos_delta[w] >= cos_half ? 1.0 : cos_delta[w] * cos_half + sin_delta[w] * sin_half;
+      if (cos_nearest <= 1e-9) continue;  // the sector's rays never reach this wall
+      safe = std::min(safe, distance[w] / cos_nearest);
+    }
+    // A little less, for the float ranges and the rounding of the bearings.
+    out[static_cast<size_t>(s)] = std::max(0.0, safe * (1.0 - 1e-6) - 1e-6);
+    const double next_c = c * cos_step - sn * sin_step;
+    sn = sn * cos_step + c * sin_step;
+    c = next_c;
+  }
 }
 
 bool ExpectedClassModel::brighterThanNeighbourhood(const ImageView& image, int u, int v) {

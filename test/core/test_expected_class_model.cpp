@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "act_color/core/expected_class_model.hpp"
@@ -118,6 +119,42 @@ TEST(ExpectedClassModel, SkippedPixelsAreNeverUnknown) {
   }
   EXPECT_NEAR(model.safeCarpetRange(Pose2D{0, 0, 0}), 7.0, 1e-9);  // 6 m half width + 1 m margin
   EXPECT_NEAR(model.safeCarpetRange(Pose2D{8, 0, 0}), 1.0, 1e-9);  // 1 m to the goal
+}
+
+TEST(ExpectedClassModel, PixelsBelowTheirSectorsSafeRangeAreNeverUnknown) {
+  const ExpectedClassModel model(act_color::test::defaultCalibration());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> x(-9.5, 9.5), y(-7.5, 7.5), th(-M_PI, M_PI);
+  std::array<double, ExpectedClassModel::kRemovalSectors> safe;
+  size_t skipped_total = 0, skipped_by_carpet_range = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    const Pose2D pose = trial == 0 ? Pose2D{0, 0, 0} : Pose2D{x(rng), y(rng), th(rng)};
+    const PoseTransform t(pose);
+    model.sectorSafeRanges(pose, safe);
+    const double carpet_range = model.safeCarpetRange(pose);
+    for (size_t i = 0; i < 580u * 580u; i += 3) {
+      const float range = model.removalRange(i);
+      if (!(range > -std::numeric_limits<float>::infinity())) continue;
+      if (ExpectedClassModel::mayBeOffField(range, carpet_range) == false) ++skipped_by_carpet_range;
+      if (ExpectedClassModel::mayBeOffField(range, safe[static_cast<size_t>(model.removalSector(i))])) continue;
+      ++skipped_total;
+      const uint8_t c = model.geometricClass(i, t);
+      ASSERT_TRUE(c == kGreen || c == kWhite)
+          << "pose " << pose.x_m << " " << pose.y_m << " " << pose.theta_rad << " pixel " << i << " class " << int(c);
+    }
+  }
+  // The sectors skip more than the one safe range for all directions does.
+  EXPECT_GT(skipped_total, skipped_by_carpet_range + skipped_by_carpet_range / 10);
+  // Beyond the goal line or off the carpet nothing is skipped.
+  model.sectorSafeRanges(Pose2D{9.2, 0.0, 0.3}, safe);
+  for (double s : safe) EXPECT_EQ(s, 0.0);
+  // At the centre: the sector that starts at +y reaches the side line plus margin after 7 m, the
+  // next one after 7 m / cos(one sector), the one that starts at +x the goal line after 9 m.
+  model.sectorSafeRanges(Pose2D{0.0, 0.0, 0.0}, safe);
+  const size_t along_y = ExpectedClassModel::kRemovalSectors / 4;
+  EXPECT_NEAR(safe[along_y], 7.0, 1e-3);
+  EXPECT_NEAR(safe[along_y + 1], 7.0 / std::cos(2 * M_PI / ExpectedClassModel::kRemovalSectors), 1e-3);
+  EXPECT_NEAR(safe[0], 9.0, 1e-3);
 }
 
 TEST(ExpectedClassModel, ExpectedLabelsMarkRejectedWhite) {

@@ -146,6 +146,10 @@ class ActTrainer {
   static constexpr int kMinOffFieldSightings = 3;
   // The cell's counts, decayed to this cycle.
   Evidence& evidence(uint32_t cell);
+  // Every change of a cell goes through setCell, which keeps mapped_ in step with the table.
+  void setCell(uint32_t cell, uint8_t k);
+  void rebuildMapped();
+  bool mapped(uint32_t cell) const { return (mapped_[cell >> 6] >> (cell & 63)) & 1u; }
 
   ExpectedClassModel model_;
   ActParams params_;
@@ -164,17 +168,26 @@ class ActTrainer {
   std::vector<uint8_t> warped_neighbour_only_;
   std::vector<Evidence> evidence_;
   std::vector<Evidence> warped_evidence_;
+  // One bit per table cell: mapped to a class (32 KB for 6 bits per channel).
+  std::vector<uint64_t> mapped_;
   int add_weight_ = 1;  // pixels one in-field sample stands for in this cycle
   // The removal step's samples start, start + remove_stride, ... that can ever be off the field,
-  // with their removal range (ExpectedClassModel::removalRange), farthest first: the samples that
-  // may be off the field at a pose are a prefix (range >= safeCarpetRange). Built for each start
-  // when first used; cleared when remove_stride changes. The order does not change the table.
+  // with their removal range (ExpectedClassModel::removalRange), by sector of bearings and
+  // farthest first within a sector: the samples that may be off the field at a pose are a prefix
+  // of each sector's list (range >= the sector's safe range). Built for each start when first
+  // used; cleared when remove_stride changes.
   struct RemovalSample {
     uint32_t pixel;
     float range_m;
   };
-  const std::vector<RemovalSample>& removalSamples(size_t start);
-  std::unordered_map<size_t, std::vector<RemovalSample>> removal_samples_;
+  struct RemovalSamples {
+    std::vector<RemovalSample> samples;
+    std::array<uint32_t, ExpectedClassModel::kRemovalSectors + 1> sector_begin{};
+  };
+  const RemovalSamples& removalSamples(size_t start);
+  std::unordered_map<size_t, RemovalSamples> removal_samples_;
+  std::array<double, ExpectedClassModel::kRemovalSectors> sector_safe_range_{};
+  std::vector<uint32_t> candidates_;  // scratch: this cycle's removal samples that may be off the field
   int removal_samples_stride_ = 0;
 };
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <opencv2/core.hpp>
 
 #include "act_color/core/calibration.hpp"
@@ -46,6 +47,16 @@ class ExpectedClassModel {
   }
   // Distance from the robot to the nearest carpet edge or goal box (0 when outside the carpet).
   double safeCarpetRange(const Pose2D& pose) const;
+
+  // The removal step's sectors: bearings (base_link) split into kRemovalSectors equal sectors.
+  static constexpr int kRemovalSectors = 64;
+  // Sector of a floor or above-horizon pixel (by its direction's bearing in base_link).
+  int removalSector(size_t pixel_index) const;
+  // Per sector, a ground range below which a floor point seen in that sector is surely on the
+  // carpet and not in a goal region at this pose (the distance along the sector's rays to the side
+  // lines plus margin and to the goal lines; 0 everywhere when the robot is beyond them). At least
+  // safeCarpetRange in directions away from the goals, and larger in most.
+  void sectorSafeRanges(const Pose2D& pose, std::array<double, kRemovalSectors>& out) const;
 
   // For the removal step (2.4): one float per pixel, -inf for pixels that are never kUnknown (not
   // imaged, chassis), else the floor range. mayBeOffField is false when geometricClass cannot be
