@@ -16,6 +16,11 @@ inline std::string sourcePath(const std::string& relative) { return std::string(
 inline core::Calibration defaultCalibration() {
   return core::loadCalibration(sourcePath("config/calibration/msl_2007_580.yaml"));
 }
+// A second camera (640x480, off-centre mirror, mirrored bearings), for checks that nothing is tuned
+// to the first.
+inline core::Calibration secondCalibration() {
+  return core::loadCalibration(sourcePath("config/calibration/msl_2007_640x480.yaml"));
+}
 inline core::Calibration contractCalibration() {
   return core::loadCalibration(sourcePath("test/data/contract_example.yaml"));
 }

@@ -28,8 +28,7 @@ struct RunResult {
   core::RunEvaluation evaluation;      // per frame and per segment, as act_replay reports them
 };
 
-RunResult runAct(const std::string& name) {
-  const core::Calibration cal = sim_test::defaultCalibration();
+RunResult runAct(const std::string& name, const core::Calibration& cal = sim_test::defaultCalibration()) {
   const sim::Renderer renderer(cal);
   const sim::Scenario scenario = sim::makeScenario(name, sim::ScenarioLength::kSmall, cal, 1);
   core::ActTrainer trainer(cal);
@@ -107,42 +106,78 @@ TEST_P(ActOnScenarios, PerClassAccuracyOutsideAdaptation) {
 INSTANTIATE_TEST_SUITE_P(Small, ActOnScenarios,
                          ::testing::Values(
                              // Measured (recall/precision, steady frames) with the core of the commit
-                             // that added neighbour-only removal and light_change_add_stride:
-                             // green .990/.999 white .989/.896 yellow .926/1.00 blue .944/1.00 black .942/.888
+                             // that added nearest-mean additions and off-field evidence removal:
+                             // green .990/1.00 white .969/.967 yellow .938/1.00 blue .945/1.00 black .938/.964
                              Case{"static_darkening",
                                   {{core::kGreen, 0.96, 0.97},
-                                   {core::kWhite, 0.95, 0.86},
-                                   {core::kYellow, 0.89, 0.97},
+                                   {core::kWhite, 0.94, 0.93},
+                                   {core::kYellow, 0.90, 0.97},
                                    {core::kBlue, 0.91, 0.97},
-                                   {core::kBlack, 0.91, 0.85}}},
-                             // green .978/1.00 white .987/.860 yellow .905/1.00 blue .916/1.00 black .901/.952
+                                   {core::kBlack, 0.90, 0.92}}},
+                             // green .979/1.00 white .964/.968 yellow .927/1.00 blue .923/1.00 black .900/.966
                              Case{"wrong_pose",
                                   {{core::kGreen, 0.95, 0.97},
-                                   {core::kWhite, 0.95, 0.82},
-                                   {core::kYellow, 0.87, 0.97},
-                                   {core::kBlue, 0.88, 0.97},
-                                   {core::kBlack, 0.87, 0.92}}},
-                             // green .987/.999 white .852/.974 yellow .827/1.00 blue .908/1.00 black .905/.937
+                                   {core::kWhite, 0.93, 0.93},
+                                   {core::kYellow, 0.89, 0.97},
+                                   {core::kBlue, 0.89, 0.97},
+                                   {core::kBlack, 0.87, 0.93}}},
+                             // green .984/.999 white .945/.967 yellow .881/.990 blue .924/1.00 black .901/.941
                              Case{"driving",
                                   {{core::kGreen, 0.95, 0.97},
-                                   {core::kWhite, 0.81, 0.94},
-                                   {core::kYellow, 0.79, 0.97},
-                                   {core::kBlue, 0.87, 0.97},
+                                   {core::kWhite, 0.91, 0.93},
+                                   {core::kYellow, 0.84, 0.96},
+                                   {core::kBlue, 0.89, 0.97},
                                    {core::kBlack, 0.87, 0.90}}},
-                             // green .995/.989 white .944/.774 yellow .927/1.00 blue .965/1.00 black .880/.802
+                             // green .994/.998 white .934/.888 yellow .927/1.00 blue .964/1.00 black .875/.808
                              Case{"spotlights",
-                                  {{core::kGreen, 0.96, 0.95},
-                                   {core::kWhite, 0.91, 0.74},
+                                  {{core::kGreen, 0.96, 0.97},
+                                   {core::kWhite, 0.90, 0.85},
                                    {core::kYellow, 0.89, 0.97},
                                    {core::kBlue, 0.93, 0.97},
-                                   {core::kBlack, 0.85, 0.77}}},
-                             // green .989/.999 white .988/.894 yellow .910/1.00 blue .930/1.00 black .906/.956
+                                   {core::kBlack, 0.84, 0.77}}},
+                             // green .989/.999 white .964/.946 yellow .936/1.00 blue .934/1.00 black .906/.966
                              Case{"sudden_brightening",
                                   {{core::kGreen, 0.96, 0.97},
-                                   {core::kWhite, 0.95, 0.86},
-                                   {core::kYellow, 0.88, 0.97},
+                                   {core::kWhite, 0.93, 0.91},
+                                   {core::kYellow, 0.90, 0.97},
                                    {core::kBlue, 0.90, 0.97},
-                                   {core::kBlack, 0.87, 0.92}}}),
+                                   {core::kBlack, 0.87, 0.93}}}),
+                         [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.scenario); });
+
+// The second camera: issue 3's targets (recall >= 0.90 green and white, >= 0.80 the others,
+// precision >= 0.80), with margin below what was measured (steady frames, scenario seed 1):
+// driving green .98/1.00 white .95/.96 yellow .89/1.00 blue .90/1.00 black .89/.95;
+// spotlights green .99/1.00 white .91/.88 yellow .96/1.00 blue .91/1.00 black .84/.83;
+// static_darkening green .98/1.00 white .97/.93 yellow .94/1.00 blue .92/1.00 black .93/.96.
+// (Scenario seeds 2 and 3 give white recall .88-.90 under spotlights and blue recall .79-.84
+// while driving: the small, distant blue goal of this camera is mostly edge pixels.)
+class ActOnSecondCamera : public ::testing::TestWithParam<Case> {};
+
+TEST_P(ActOnSecondCamera, PerClassAccuracyOutsideAdaptation) {
+  const Case& c = GetParam();
+  const RunResult r = runAct(c.scenario, sim_test::secondCalibration());
+  expectThresholds(r.steady, c.thresholds, std::string(c.scenario) + " (640x480 camera)");
+}
+
+INSTANTIATE_TEST_SUITE_P(Small, ActOnSecondCamera,
+                         ::testing::Values(Case{"driving",
+                                                {{core::kGreen, 0.95, 0.97},
+                                                 {core::kWhite, 0.90, 0.90},
+                                                 {core::kYellow, 0.80, 0.97},
+                                                 {core::kBlue, 0.85, 0.97},
+                                                 {core::kBlack, 0.85, 0.90}}},
+                                           Case{"spotlights",
+                                                {{core::kGreen, 0.96, 0.97},
+                                                 {core::kWhite, 0.87, 0.84},
+                                                 {core::kYellow, 0.90, 0.97},
+                                                 {core::kBlue, 0.86, 0.97},
+                                                 {core::kBlack, 0.80, 0.79}}},
+                                           Case{"static_darkening",
+                                                {{core::kGreen, 0.95, 0.97},
+                                                 {core::kWhite, 0.93, 0.89},
+                                                 {core::kYellow, 0.90, 0.97},
+                                                 {core::kBlue, 0.88, 0.97},
+                                                 {core::kBlack, 0.90, 0.92}}}),
                          [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.scenario); });
 
 // Cycles after a sudden change of light until each class's recall stays within 0.02 of its final
