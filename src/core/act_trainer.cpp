@@ -207,6 +207,22 @@ bool ActTrainer::nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) cons
   return false;
 }
 
+void ActTrainer::dropColorsOfOtherClusters(std::vector<Eigen::Vector3f>& colors, uint8_t k) const {
+  const ClassCluster& own = clusters_[k];
+  auto belongsElsewhere = [&](const Eigen::Vector3f& c) {
+    const Eigen::Vector3d color = c.cast<double>();
+    for (const int j : {kGreen, kBlack}) {
+      const ClassCluster& other = clusters_[j];
+      if (j == k || !other.trained()) continue;
+      const double to_other = (other.mean() - color).norm();
+      if (to_other >= params_.zeta * other.sigma()) continue;
+      if (!own.trained() || to_other / other.sigma() < (own.mean() - color).norm() / own.sigma()) return true;
+    }
+    return false;
+  };
+  colors.erase(std::remove_if(colors.begin(), colors.end(), belongsElsewhere), colors.end());
+}
+
 bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const {
   if (current == kUnknown || current == k || current >= kNumClasses) return false;
   const ClassCluster& other = clusters_[current];
@@ -399,8 +415,13 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       }
     }
   }
-  for (int k = 1; k < kNumClasses; ++k) {
+  // Green (the carpet) and black (the own chassis) first: they are seen where expected whatever
+  // else is on the field, and the goals then leave out colors that are theirs (a robot in front of
+  // a goal, the carpet of a goal region under a wrong pose), also before the goal's first update.
+  constexpr int kUpdateOrder[kNumClasses - 1] = {kGreen, kBlack, kWhite, kYellow, kBlue};
+  for (const int k : kUpdateOrder) {
     if (params_.robust_clusters && k != kGreen) {
+      if (k == kYellow || k == kBlue) dropColorsOfOtherClusters(samples_[k], static_cast<uint8_t>(k));
       stats.cluster_samples[k] = clusters_[k].updateFromInliers(samples_[k], cluster_params);
     } else {
       stats.doublings += clusters_[k].update(samples_[k], cluster_params);

@@ -457,3 +457,40 @@ TEST_F(ActTrainerTest, ColorsSeenMoreOftenOffTheFieldThanInItAreRemovedWithinXiS
   EXPECT_LT(patch.second, 2500);
   EXPECT_EQ(patch.first, kGreen);
 }
+
+TEST_F(ActTrainerTest, ARobotInFrontOfAGoalAtStartUpDoesNotBecomeTheGoal) {
+  // Facing the blue goal from 2 m, with 70% of the goal's pixels showing a robot in the own
+  // chassis's color: the goal's first samples are mostly robot. Black (the chassis) is updated
+  // first, and the goal leaves its colors out: blue keeps the goal's color, the robot is black.
+  const Pose2D facing_goal{-7.0, 0.5, M_PI};
+  auto frame = paintFlatFrame(model, facing_goal, 1.0, 1);
+  const PoseTransform t(facing_goal);
+  cv::Vec3b chassis(0, 0, 0), goal(0, 0, 0);
+  int goal_pixels = 0, covered = 0;
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      const uint8_t k = model.geometricClass(v * 580 + u, t);
+      if (k == kBlack) chassis = frame.rgb.at<cv::Vec3b>(v, u);
+      if (k != kBlue) continue;
+      ++goal_pixels;
+      goal = frame.rgb.at<cv::Vec3b>(v, u);
+      const uint32_t hash = static_cast<uint32_t>(v * 580 + u) * 2654435761u;
+      if ((hash >> 16) % 10 < 7) {
+        frame.rgb.at<cv::Vec3b>(v, u) = chassis;
+        ++covered;
+      }
+    }
+  }
+  ASSERT_GT(goal_pixels, 2000);
+  ASSERT_GT(covered, goal_pixels / 2);
+  for (uint32_t seed = 1; seed <= 4; ++seed) {
+    ActParams p;
+    p.seed = seed;
+    ActTrainer trainer(cal, p);
+    trainer.bootstrap(view(frame.rgb), facing_goal, 20);
+    const Eigen::Vector3d black = trainer.clusters()[kBlack].mean(), blue = trainer.clusters()[kBlue].mean();
+    EXPECT_GT((blue - black).norm(), 60.0) << "seed " << seed << ": blue " << blue.transpose();
+    EXPECT_EQ(trainer.lut().classOf(chassis[0], chassis[1], chassis[2]), kBlack) << "seed " << seed;
+    EXPECT_EQ(trainer.lut().classOf(goal[0], goal[1], goal[2]), kBlue) << "seed " << seed;
+  }
+}

@@ -130,6 +130,11 @@ class ActTrainer {
   // True when the color is mapped to a trained class other than k and is nearer to that class's
   // cluster than to k's, in units of sigma.
   bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
+  // Leaves out of k's cluster samples the colors within zeta * sigma of the green or the black
+  // cluster (the carpet, the chassis and robots; both updated first) and nearer to it than to k's
+  // (in sigmas; any such color while k is untrained). Not white: its sphere is wide under uneven
+  // light and would keep a lit goal from ever being seeded.
+  void dropColorsOfOtherClusters(std::vector<Eigen::Vector3f>& colors, uint8_t k) const;
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
   // The class a sample expected as k trains (robots_train_black re-routes green to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
