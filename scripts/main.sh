@@ -6,7 +6,7 @@
 # Then it renders the scenario bags (sudden darkening, wrong pose, driving under changing light,
 # spotlights and shadows, sudden brightening), runs ACT and the segmentation over each with
 # act_replay, and prints per-class recall/precision and the cycles each class needed after every
-# light change. Installs what is missing and builds first.
+# light change; the same on a second camera. Installs what is missing and builds first.
 #   scripts/main.sh            small scenarios (a few dozen frames each, about a minute)
 #   scripts/main.sh --full     full-length scenarios (hundreds of frames each)
 set -eo pipefail
@@ -41,18 +41,27 @@ if ! grep -q "accuracy over" "$demo_log"; then
 fi
 echo
 
-calibration="$ACT_ROOT/config/calibration/msl_2007_580.yaml"
-scenarios="$ACT_WS/scenarios/$length"
-mkdir -p "$scenarios/out"
-echo "act_color: rendering the $length scenarios into $scenarios"
-rosrun act_color act_make_scenarios --calibration "$calibration" --scenario all --length "$length" \
-  --output-dir "$scenarios" --png "$scenarios/png" | sed 's/^/  /'
-for bag in "$scenarios"/*.bag; do
-  name=$(basename "$bag" .bag)
+# The scenarios on the package's camera, then on a second camera (640x480, off-centre mirror,
+# mirrored bearings), which nothing is tuned to.
+for camera in msl_2007_580 msl_2007_640x480; do
+  calibration="$ACT_ROOT/config/calibration/$camera.yaml"
+  if [ "$camera" = msl_2007_580 ]; then
+    scenarios="$ACT_WS/scenarios/$length"
+  else
+    scenarios="$ACT_WS/scenarios/$length-$camera"
+  fi
+  mkdir -p "$scenarios/out"
   echo
-  echo "== $name"
-  rosrun act_color act_replay --bag "$bag" --calibration "$calibration" \
-    --output "$scenarios/out/$name.labels.bag" --csv "$scenarios/out/$name.csv" --brief --no-progress
+  echo "act_color: rendering the $length scenarios for $camera.yaml into $scenarios"
+  rosrun act_color act_make_scenarios --calibration "$calibration" --scenario all --length "$length" \
+    --output-dir "$scenarios" --png "$scenarios/png" | sed 's/^/  /'
+  for bag in "$scenarios"/*.bag; do
+    name=$(basename "$bag" .bag)
+    echo
+    echo "== $name ($camera)"
+    rosrun act_color act_replay --bag "$bag" --calibration "$calibration" \
+      --output "$scenarios/out/$name.labels.bag" --csv "$scenarios/out/$name.csv" --brief --no-progress
+  done
+  echo
+  echo "act_color: labels, tables and per-frame CSVs in $scenarios/out, first frames as PNG in $scenarios/png"
 done
-echo
-echo "act_color: labels, tables and per-frame CSVs in $scenarios/out, first frames as PNG in $scenarios/png"
