@@ -146,8 +146,8 @@ class ActTrainer {
     float off_field = 0.f;
     uint32_t stamp = 0;  // cycle up to which the counts are decayed
   };
-  static constexpr double kEvidenceHalfLifeCycles = 20.0;
-  static constexpr size_t kEvidenceMemory = 256;  // cycles after which counts are 0
+  static constexpr double kEvidenceHalfLifeCycles = 40.0;  // 20: black's recall swung more
+  static constexpr size_t kEvidenceMemory = 256;           // cycles after which counts are 0
   static constexpr int kMinOffFieldSightings = 3;
   // The cell's counts, decayed to this cycle.
   Evidence& evidence(uint32_t cell);
