@@ -123,8 +123,6 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
   if (params_.robust_clusters && claimedByOtherClass(color, lut_.at(cell), k)) return 0;
   if (nearerToOtherMean(color, k)) return 0;
-  // A cell sampled for k before in this cycle has had its neighbourhood filled with this very
-  // cluster: doing it again changes nothing.
   const uint32_t this_cycle = static_cast<uint32_t>(revision_ + 1);
   if (params_.evidence_removal_ratio > 0) {
     // The counts stay when a cell is removed and comes back: a color seen more often off the
@@ -136,6 +134,8 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     e.in_field += static_cast<float>(add_weight_);
     if (current != k && e.off_field > params_.evidence_removal_ratio * e.in_field) return 0;
   }
+  // A cell sampled for k before in this cycle has had its neighbourhood filled with this very
+  // cluster: doing it again changes nothing.
   const uint32_t last_confirmed = confirmed_[cell];
   const bool was_k = lut_.at(cell) == k;
   if (last_confirmed == this_cycle && was_k) return 0;
@@ -158,7 +158,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   for (int a = std::max(0, i0 - n); a <= std::min(cells - 1, i0 + n); ++a) {
     for (int b = std::max(0, i1 - n); b <= std::min(cells - 1, i1 + n); ++b) {
       for (int d = std::max(0, i2 - n); d <= std::min(cells - 1, i2 + n); ++d) {
-        const uint32_t neighbour = (static_cast<uint32_t>(a) << (2 * bits)) | (static_cast<uint32_t>(b) << bits) | d;
+        const uint32_t neighbour = lut_.cellIndex(a, b, d);
         const uint8_t current = lut_.at(neighbour);
         if (current == k) continue;
         const Eigen::Vector3d centre((a << shift) + half, (b << shift) + half, (d << shift) + half);
@@ -265,7 +265,7 @@ void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vect
     for (int a = first[0]; a <= last[0]; ++a) {
       for (int b = first[1]; b <= last[1]; ++b) {
         for (int d = first[2]; d <= last[2]; ++d) {
-          const uint32_t target = (static_cast<uint32_t>(a) << (2 * bits)) | (static_cast<uint32_t>(b) << bits) | d;
+          const uint32_t target = lut_.cellIndex(a, b, d);
           warped_[target] = k;
           warped_neighbour_only_[target] = neighbour_only_[cell];
           warped_evidence_[target] = evidence_[cell];
@@ -291,6 +291,11 @@ void ActTrainer::setCell(uint32_t cell, uint8_t k) {
   } else {
     mapped_[cell >> 6] |= bit;
   }
+}
+
+void ActTrainer::removeCell(uint32_t cell) {
+  setCell(cell, kUnknown);
+  neighbour_only_[cell] = 0;
 }
 
 void ActTrainer::rebuildMapped() {
@@ -503,8 +508,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       e.off_field += static_cast<float>(params_.remove_stride);
       if (e.off_field >= kMinOffFieldSightings * params_.remove_stride &&
           e.off_field > params_.evidence_removal_ratio * e.in_field) {
-        setCell(cell, kUnknown);
-        neighbour_only_[cell] = 0;
+        removeCell(cell);
         confirmed_[cell] = 0;
         ++stats.removed[k];
         continue;
@@ -516,8 +520,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     }
     if (neighbour_only_[cell] ||
         (remove_mean[k] - Eigen::Vector3f(c[0], c[1], c[2])).squaredNorm() > remove_radius_sq[k]) {
-      setCell(cell, kUnknown);
-      neighbour_only_[cell] = 0;
+      removeCell(cell);
       ++stats.removed[k];
     }
   }

@@ -20,36 +20,8 @@ ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
   }
 }
 
-bool ExpectedClassModel::offField(size_t pixel_index, const PoseTransform& pose) const {
-  const PixelRay& ray = camera_.ray(pixel_index);
-  if (ray.region != PixelRegion::kFloor && ray.region != PixelRegion::kAboveHorizon) return false;
-  // The same arithmetic as geometricClass: the same goal test, and off the carpet is kUnknown.
-  const Eigen::Vector3d origin(pose.x_m, pose.y_m, camera_.viewpointHeight());
-  const Eigen::Vector3d dir(pose.cos_theta * ray.dir_x - pose.sin_theta * ray.dir_y,
-                            pose.sin_theta * ray.dir_x + pose.cos_theta * ray.dir_y, ray.dir_z);
-  if (ray.region == PixelRegion::kAboveHorizon) {
-    return field_.goalHit(origin, dir, std::numeric_limits<double>::infinity()) == kUnknown;
-  }
-  double fx, fy;
-  pose.apply(ray.ground_x_m, ray.ground_y_m, &fx, &fy);
-  if (std::abs(fx) >= field_.halfLength() || std::abs(pose.x_m) >= field_.halfLength()) {
-    const double t_floor = camera_.viewpointHeight() / -dir.z();
-    if (field_.goalHit(origin, dir, t_floor) != kUnknown) return false;
-  }
-  return !field_.onCarpet(fx, fy);
-}
-
-uint8_t ExpectedClassModel::geometricClass(size_t pixel_index, const PoseTransform& pose) const {
-  const PixelRay& ray = camera_.ray(pixel_index);
-  switch (ray.region) {
-    case PixelRegion::kNotImaged:
-      return kNotImaged;
-    case PixelRegion::kChassis:
-      return kBlack;
-    case PixelRegion::kFloor:
-    case PixelRegion::kAboveHorizon:
-      break;
-  }
+template <bool kTellLines>
+uint8_t ExpectedClassModel::classOfRay(const PixelRay& ray, const PoseTransform& pose) const {
   const Eigen::Vector3d origin(pose.x_m, pose.y_m, camera_.viewpointHeight());
   const Eigen::Vector3d dir(pose.cos_theta * ray.dir_x - pose.sin_theta * ray.dir_y,
                             pose.sin_theta * ray.dir_x + pose.cos_theta * ray.dir_y, ray.dir_z);
@@ -64,7 +36,28 @@ uint8_t ExpectedClassModel::geometricClass(size_t pixel_index, const PoseTransfo
     const ColorClass goal = field_.goalHit(origin, dir, t_floor);
     if (goal != kUnknown) return goal;
   }
-  return field_.floorClass(fx, fy);
+  if (kTellLines) return field_.floorClass(fx, fy);
+  return field_.onCarpet(fx, fy) ? kGreen : kUnknown;
+}
+
+bool ExpectedClassModel::offField(size_t pixel_index, const PoseTransform& pose) const {
+  const PixelRay& ray = camera_.ray(pixel_index);
+  if (ray.region != PixelRegion::kFloor && ray.region != PixelRegion::kAboveHorizon) return false;
+  return classOfRay<false>(ray, pose) == kUnknown;
+}
+
+uint8_t ExpectedClassModel::geometricClass(size_t pixel_index, const PoseTransform& pose) const {
+  const PixelRay& ray = camera_.ray(pixel_index);
+  switch (ray.region) {
+    case PixelRegion::kNotImaged:
+      return kNotImaged;
+    case PixelRegion::kChassis:
+      return kBlack;
+    case PixelRegion::kFloor:
+    case PixelRegion::kAboveHorizon:
+      break;
+  }
+  return classOfRay<true>(ray, pose);
 }
 
 double ExpectedClassModel::safeCarpetRange(const Pose2D& pose) const {
@@ -80,9 +73,8 @@ double ExpectedClassModel::safeCarpetRange(const Pose2D& pose) const {
 }
 
 int ExpectedClassModel::removalSector(size_t pixel_index) const {
-  const PixelRay& ray = camera_.ray(pixel_index);
   constexpr double kTwoPi = 2.0 * M_PI;
-  double bearing = std::atan2(static_cast<double>(ray.dir_y), static_cast<double>(ray.dir_x));
+  double bearing = std::fmod(static_cast<double>(camera_.ray(pixel_index).bearing_rad), kTwoPi);
   if (bearing < 0) bearing += kTwoPi;
   const int sector = static_cast<int>(bearing / kTwoPi * kRemovalSectors);
   return std::clamp(sector, 0, kRemovalSectors - 1);

@@ -140,22 +140,20 @@ void fig1(const core::Calibration& cal, const sim::Renderer& renderer, const std
       tools::Series sz{images[i].first, {}, {}, {}, false};
       sz.color = i == 0 ? cv::Scalar(120, 0, 0) : i == 1 ? cv::Scalar(0, 140, 0) : cv::Scalar(0, 140, 255);
       tools::Series sx = sz;
-      for (double z : zetas) {
-        ActParams p = mode.params;
-        p.zeta = z;
-        const double f = fitnessOf(p, frames[i]);
-        sz.x.push_back(z);
-        sz.y.push_back(f);
-        csv_z << mode.name << "," << images[i].first << "," << z << "," << p.xi << "," << fmt(f, 5) << "\n";
-      }
-      for (double x : xis) {
-        ActParams p = mode.params;
-        p.xi = x;
-        const double f = fitnessOf(p, frames[i]);
-        sx.x.push_back(x);
-        sx.y.push_back(f);
-        csv_x << mode.name << "," << images[i].first << "," << p.zeta << "," << x << "," << fmt(f, 5) << "\n";
-      }
+      // Fitness over the values of one parameter, the others at the mode's defaults.
+      auto sweep = [&](const std::vector<double>& values, double ActParams::*param, tools::Series& series,
+                       std::ostream& csv) {
+        for (double value : values) {
+          ActParams p = mode.params;
+          p.*param = value;
+          const double f = fitnessOf(p, frames[i]);
+          series.x.push_back(value);
+          series.y.push_back(f);
+          csv << mode.name << "," << images[i].first << "," << p.zeta << "," << p.xi << "," << fmt(f, 5) << "\n";
+        }
+      };
+      sweep(zetas, &ActParams::zeta, sz, csv_z);
+      sweep(xis, &ActParams::xi, sx, csv_x);
       auto range = [](const tools::Series& se, double* best) {
         *best = *std::min_element(se.y.begin(), se.y.end());
         double lo = 1e9, hi = -1e9;

@@ -72,14 +72,16 @@ class BadInputs : public ::testing::Test {
     });
     spinner_.start();
     // roscpp counts one subscriber per process: the manager.
-    ASSERT_TRUE(waiter_.waitFor(30.0, [this] {
-      return image_pub_.getNumSubscribers() >= 1 && pose_pub_.getNumSubscribers() >= 1 &&
-             labels_sub_.getNumPublishers() >= 1 && lut_sub_.getNumPublishers() >= 1 &&
-             log_sub_.getNumPublishers() >= 1;
-    })) << "the nodelets did not connect: image subscribers " << image_pub_.getNumSubscribers()
-        << ", pose subscribers " << pose_pub_.getNumSubscribers() << ", labels publishers "
-        << labels_sub_.getNumPublishers() << ", table publishers " << lut_sub_.getNumPublishers()
-        << ", /rosout publishers " << log_sub_.getNumPublishers();
+    ASSERT_TRUE(waiter_.waitFor(30.0,
+                                [this] {
+                                  return image_pub_.getNumSubscribers() >= 1 && pose_pub_.getNumSubscribers() >= 1 &&
+                                         labels_sub_.getNumPublishers() >= 1 && lut_sub_.getNumPublishers() >= 1 &&
+                                         log_sub_.getNumPublishers() >= 1;
+                                }))
+        << "the nodelets did not connect: image subscribers " << image_pub_.getNumSubscribers() << ", pose subscribers "
+        << pose_pub_.getNumSubscribers() << ", labels publishers " << labels_sub_.getNumPublishers()
+        << ", table publishers " << lut_sub_.getNumPublishers() << ", /rosout publishers "
+        << log_sub_.getNumPublishers();
   }
 
   // Log messages of the manager at `level` or above containing `text`.

@@ -87,11 +87,7 @@ TEST(Pipeline, SimulatedScenarioAccuracy) {
   EXPECT_EQ(labeled, frames) << "frames without labels";
   std::printf("pipeline on %s: %zu of %zu frames labeled; steady frames:\n%s", scenario_name.c_str(), labeled, frames,
               metrics.report().c_str());
-  for (size_t i = 0; i < core::trainableClasses().size(); ++i) {
-    const int k = core::trainableClasses()[i];
-    EXPECT_GE(metrics.recall(k), min_recall[i]) << "recall of " << core::className(k);
-    EXPECT_GE(metrics.precision(k), min_precision[i]) << "precision of " << core::className(k);
-  }
+  act_color_test::expectPerClassAtLeast(metrics, min_recall, min_precision);
 }
 
 }  // namespace

@@ -102,11 +102,7 @@ TEST(Replay, LabelsForEveryFrame) {
   EXPECT_EQ(labeled, image_stamps.size()) << "images without labels";
   EXPECT_EQ(labels.size(), labeled) << "labels with stamps of no image in the bag";
   EXPECT_EQ(duplicates, 0u);
-  for (size_t i = 0; i < core::trainableClasses().size() && i < min_recall.size(); ++i) {
-    const int k = core::trainableClasses()[i];
-    EXPECT_GE(metrics.recall(k), min_recall[i]) << "recall of " << core::className(k);
-    EXPECT_GE(metrics.precision(k), min_precision[i]) << "precision of " << core::className(k);
-  }
+  act_color_test::expectPerClassAtLeast(metrics, min_recall, min_precision);
 }
 
 }  // namespace

@@ -1,12 +1,17 @@
 #pragma once
 
+#include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
-#include <algorithm>
 #include <functional>
 #include <mutex>
+#include <vector>
+
+#include "act_color/core/metrics.hpp"
+#include "act_color/core/types.hpp"
 
 namespace act_color_test {
 
@@ -19,9 +24,9 @@ class Waiter {
   // True when `done` became true before `timeout_s` (wall time) passed; `done` runs under mutex().
   bool waitFor(double timeout_s, const std::function<bool()>& done) {
     std::unique_lock<std::mutex> lock(mutex_);
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                              std::chrono::duration<double>(timeout_s));
+    const auto deadline =
+        std::chrono::steady_clock::now() +
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(timeout_s));
     // Re-checks at least every 100 ms as well, for conditions that depend on time.
     while (!done()) {
       if (std::chrono::steady_clock::now() >= deadline) return false;
@@ -36,5 +41,17 @@ class Waiter {
   std::mutex mutex_;
   std::condition_variable cv_;
 };
+
+// Recall and precision of each trainable class (in core::trainableClasses() order) at least the
+// given values; classes beyond the lists are not checked.
+inline void expectPerClassAtLeast(const act_color::core::ClassificationMetrics& metrics,
+                                  const std::vector<double>& min_recall, const std::vector<double>& min_precision) {
+  const auto& classes = act_color::core::trainableClasses();
+  for (size_t i = 0; i < classes.size() && i < min_recall.size() && i < min_precision.size(); ++i) {
+    const int k = classes[i];
+    EXPECT_GE(metrics.recall(k), min_recall[i]) << "recall of " << act_color::core::className(k);
+    EXPECT_GE(metrics.precision(k), min_precision[i]) << "precision of " << act_color::core::className(k);
+  }
+}
 
 }  // namespace act_color_test

@@ -127,14 +127,15 @@ class ActTrainer {
   ClusterParams clusterParams() const;
   // 2.3 for one color; returns the number of cells that changed to class k.
   uint32_t addColor(const uint8_t c[3], uint8_t k);
-  // True when the color is mapped to a trained class other than k and is nearer to that class's
-  // cluster than to k's, in units of sigma.
+  // ActParams::nearest_mean: another trained cluster's mean is nearer to the color than k's.
   bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
   // Leaves out of k's cluster samples the colors within zeta * sigma of the green or the black
   // cluster (the carpet, the chassis and robots; both updated first) and nearer to it than to k's
   // (in sigmas; any such color while k is untrained). Not white: its sphere is wide under uneven
   // light and would keep a lit goal from ever being seeded.
   void dropColorsOfOtherClusters(std::vector<Eigen::Vector3f>& colors, uint8_t k) const;
+  // True when the color is mapped to a trained class other than k and is nearer to that class's
+  // cluster than to k's, in units of sigma.
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
   // The class a sample expected as k trains (robots_train_black re-routes green to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
@@ -153,6 +154,8 @@ class ActTrainer {
   Evidence& evidence(uint32_t cell);
   // Every change of a cell goes through setCell, which keeps mapped_ in step with the table.
   void setCell(uint32_t cell, uint8_t k);
+  // The cell back to kUnknown (2.4), no longer neighbour-only.
+  void removeCell(uint32_t cell);
   void rebuildMapped();
   bool mapped(uint32_t cell) const { return (mapped_[cell >> 6] >> (cell & 63)) & 1u; }
 

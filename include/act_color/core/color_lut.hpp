@@ -20,9 +20,11 @@ class ColorLut {
   size_t size() const { return table_.size(); }
 
   uint32_t index(uint8_t c0, uint8_t c1, uint8_t c2) const {
-    return (static_cast<uint32_t>(c0 >> shift_) << (2 * bits_)) | (static_cast<uint32_t>(c1 >> shift_) << bits_) |
-           static_cast<uint32_t>(c2 >> shift_);
+    return cellIndex(static_cast<uint32_t>(c0 >> shift_), static_cast<uint32_t>(c1 >> shift_),
+                     static_cast<uint32_t>(c2 >> shift_));
   }
+  // The cell of per-channel cell numbers i0, i1, i2 in [0, 2^bits).
+  uint32_t cellIndex(uint32_t i0, uint32_t i1, uint32_t i2) const { return (i0 << (2 * bits_)) | (i1 << bits_) | i2; }
   uint8_t classOf(uint8_t c0, uint8_t c1, uint8_t c2) const { return table_[index(c0, c1, c2)]; }
   uint8_t at(uint32_t cell) const { return table_[cell]; }
   void set(uint32_t cell, uint8_t class_id) {

@@ -50,7 +50,7 @@ class ExpectedClassModel {
 
   // The removal step's sectors: bearings (base_link) split into kRemovalSectors equal sectors.
   static constexpr int kRemovalSectors = 64;
-  // Sector of a floor or above-horizon pixel (by its direction's bearing in base_link).
+  // Sector of a floor or above-horizon pixel (by its bearing in base_link).
   int removalSector(size_t pixel_index) const;
   // Per sector, a ground range below which a floor point seen in that sector is surely on the
   // carpet and not in a goal region at this pose (the distance along the sector's rays to the side
@@ -60,7 +60,8 @@ class ExpectedClassModel {
 
   // For the removal step (2.4): one float per pixel, -inf for pixels that are never kUnknown (not
   // imaged, chassis), else the floor range. mayBeOffField is false when geometricClass cannot be
-  // kUnknown at a pose whose safeCarpetRange is safe_range_m.
+  // kUnknown for a pixel whose safe range (safeCarpetRange, or its sector's from sectorSafeRanges)
+  // is safe_range_m.
   float removalRange(size_t pixel_index) const { return removal_range_m_[pixel_index]; }
   static bool mayBeOffField(float removal_range_m, double safe_range_m) { return !(removal_range_m < safe_range_m); }
   size_t pixels() const { return removal_range_m_.size(); }
@@ -73,6 +74,12 @@ class ExpectedClassModel {
   // from carpet.
   bool offField(size_t pixel_index, const PoseTransform& pose) const;
 
+ private:
+  // Goal or floor class of a floor or above-horizon ray; carpet as kGreen unless kTellLines.
+  template <bool kTellLines>
+  uint8_t classOfRay(const PixelRay& ray, const PoseTransform& pose) const;
+
+ public:
   // eq. 1: the pixel is brighter than the mean of its 5x5 neighbourhood. False within 2 px of
   // the image border.
   static bool brighterThanNeighbourhood(const ImageView& image, int u, int v);
