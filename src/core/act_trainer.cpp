@@ -28,6 +28,34 @@ constexpr uint32_t kNeighbourhoodRefreshCycles = 8;
 // Largest ratio between the per-channel gains of a change of light (see cycle()).
 constexpr double kMaxGainSpread = 2.5;
 
+// Every stride-th pixel from `start`, with its column and row kept up to date without a division.
+struct StridedPixels {
+  StridedPixels(size_t start, int stride, int width)
+      : i(start),
+        u(static_cast<int>(start % width)),
+        v(static_cast<int>(start / width)),
+        width_(width),
+        stride_(static_cast<size_t>(stride)),
+        du_(stride % width),
+        dv_(stride / width) {}
+  void next() {
+    i += stride_;
+    u += du_;
+    v += dv_;
+    if (u >= width_) {
+      u -= width_;
+      ++v;
+    }
+  }
+  size_t i;
+  int u, v;
+
+ private:
+  int width_;
+  size_t stride_;
+  int du_, dv_;
+};
+
 }  // namespace
 
 void ActParams::validate() const {
@@ -353,26 +381,21 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   const size_t pixels = static_cast<size_t>(width) * image.height;
   auto randomStart = [this](int stride) { return std::uniform_int_distribution<int>(0, stride - 1)(rng_); };
   // Expected class with eq. 1 for white; kNotImaged for pixels that train nothing.
-  auto expected = [&](size_t i) -> uint8_t {
-    const uint8_t c = model_.geometricClass(i, transform);
-    if (c == kWhite && params_.white_filter &&
-        !ExpectedClassModel::brighterThanNeighbourhood(image, static_cast<int>(i % width),
-                                                       static_cast<int>(i / width))) {
+  auto expected = [&](const StridedPixels& p) -> uint8_t {
+    const uint8_t c = model_.geometricClass(p.i, transform);
+    if (c == kWhite && params_.white_filter && !ExpectedClassModel::brighterThanNeighbourhood(image, p.u, p.v)) {
       return kNotImaged;
     }
     return c;
   };
-  auto colorAt = [&](size_t i, uint8_t out[3]) {
-    image.color(static_cast<int>(i % width), static_cast<int>(i / width), out);
-  };
 
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
-  for (size_t i = randomStart(params_.cluster_stride); i < pixels; i += params_.cluster_stride) {
-    const uint8_t expected_k = expected(i);
+  for (StridedPixels p(randomStart(params_.cluster_stride), params_.cluster_stride, width); p.i < pixels; p.next()) {
+    const uint8_t expected_k = expected(p);
     if (expected_k == kUnknown || expected_k >= kNumClasses) continue;
     uint8_t c[3];
-    colorAt(i, c);
+    image.color(p.u, p.v, c);
     samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
   }
   const ClusterParams cluster_params = clusterParams();
@@ -438,11 +461,11 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   const int add_stride =
       stats.light_change ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
   add_weight_ = add_stride;
-  for (size_t i = randomStart(add_stride); i < pixels; i += add_stride) {
-    const uint8_t k = expected(i);
+  for (StridedPixels p(randomStart(add_stride), add_stride, width); p.i < pixels; p.next()) {
+    const uint8_t k = expected(p);
     if (k == kUnknown || k >= kNumClasses) continue;
     uint8_t c[3];
-    colorAt(i, c);
+    image.color(p.u, p.v, c);
     const uint8_t trained = trainedClass(k, c);
     stats.added[trained] += addColor(c, trained);
   }
@@ -457,20 +480,10 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
     for (uint32_t j = samples.sector_begin[sector]; j < samples.sector_begin[sector + 1]; ++j) {
       if (!ExpectedClassModel::mayBeOffField(samples.samples[j].range_m, safe_range)) break;
-      candidates_.push_back(samples.samples[j].pixel);
+      candidates_.push_back(&samples.samples[j]);
     }
   }
   const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
-  // Row and column without a division (exact for any image of less than 2^26 pixels).
-  const double inverse_width = 1.0 / width;
-  auto rowColumn = [&](size_t i, size_t& v, size_t& u) {
-    v = static_cast<size_t>(static_cast<double>(i) * inverse_width);
-    u = i - v * static_cast<size_t>(width);
-    if (u >= static_cast<size_t>(width)) {
-      u -= width;
-      ++v;
-    }
-  };
   // |mu_k - c| > xi * sigma_k, compared as squared distances in float.
   std::array<Eigen::Vector3f, kNumClasses> remove_mean;
   std::array<float, kNumClasses> remove_radius_sq;
@@ -484,19 +497,16 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   const size_t candidates = candidates_.size();
   for (size_t j = 0; j < candidates; ++j) {
     if (j + kAhead < candidates) {
-      const size_t ahead = candidates_[j + kAhead];
-      size_t v, u;
-      rowColumn(ahead, v, u);
-      model_.prefetchRemoval(ahead);
-      __builtin_prefetch(image.data + v * image.step + u * bytes_per_pixel);
+      const RemovalSample& ahead = *candidates_[j + kAhead];
+      model_.prefetchRemoval(ahead.pixel);
+      __builtin_prefetch(image.data + ahead.v * image.step + ahead.u * bytes_per_pixel);
     }
     // The color first: most colors seen off the field are mapped to no class, and then whether
     // the pixel really is off the field (a ray cast) does not matter.
-    const size_t i = candidates_[j];
-    size_t v, u;
-    rowColumn(i, v, u);
+    const RemovalSample& sample = *candidates_[j];
+    const size_t i = sample.pixel;
     uint8_t c[3];
-    image.color(static_cast<int>(u), static_cast<int>(v), c);
+    image.color(sample.u, sample.v, c);
     const uint32_t cell = lut_.index(c[0], c[1], c[2]);
     if (!mapped(cell)) continue;  // the bitmap fits the L1 cache, the table does not
     const uint8_t k = lut_.at(cell);
@@ -544,7 +554,9 @@ const ActTrainer::RemovalSamples& ActTrainer::removalSamples(size_t start) {
     for (size_t i = start; i < model_.pixels(); i += stride) {
       const float range = model_.removalRange(i);
       if (range > -std::numeric_limits<float>::infinity()) {  // can be off the field at some pose
-        entries.push_back({model_.removalSector(i), {static_cast<uint32_t>(i), range}});
+        const auto u = static_cast<uint16_t>(i % model_.camera().width());
+        const auto v = static_cast<uint16_t>(i / model_.camera().width());
+        entries.push_back({model_.removalSector(i), {static_cast<uint32_t>(i), range, u, v}});
       }
     }
     // By sector, farthest first within each; the order does not change the table.

@@ -187,6 +187,7 @@ class ActTrainer {
   struct RemovalSample {
     uint32_t pixel;
     float range_m;
+    uint16_t u, v;  // column and row of the pixel (calibrated images are at most 16384 px wide)
   };
   struct RemovalSamples {
     std::vector<RemovalSample> samples;
@@ -195,7 +196,7 @@ class ActTrainer {
   const RemovalSamples& removalSamples(size_t start);
   std::unordered_map<size_t, RemovalSamples> removal_samples_;
   std::array<double, ExpectedClassModel::kRemovalSectors> sector_safe_range_{};
-  std::vector<uint32_t> candidates_;  // scratch: this cycle's removal samples that may be off the field
+  std::vector<const RemovalSample*> candidates_;  // scratch: this cycle's samples that may be off the field
   int removal_samples_stride_ = 0;
 };
 
