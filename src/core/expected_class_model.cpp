@@ -22,18 +22,21 @@ ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
 
 template <bool kTellLines>
 uint8_t ExpectedClassModel::classOfRay(const PixelRay& ray, const PoseTransform& pose) const {
-  const Eigen::Vector3d origin(pose.x_m, pose.y_m, camera_.viewpointHeight());
-  const Eigen::Vector3d dir(pose.cos_theta * ray.dir_x - pose.sin_theta * ray.dir_y,
-                            pose.sin_theta * ray.dir_x + pose.cos_theta * ray.dir_y, ray.dir_z);
-  if (ray.region == PixelRegion::kAboveHorizon) {
-    return field_.goalHit(origin, dir, std::numeric_limits<double>::infinity());
-  }
+  // The ray in the field frame, computed only when a goal may be hit: up to the floor point or,
+  // above the horizon, without end.
+  auto goalHit = [&](bool to_floor) {
+    const Eigen::Vector3d origin(pose.x_m, pose.y_m, camera_.viewpointHeight());
+    const Eigen::Vector3d dir(pose.cos_theta * ray.dir_x - pose.sin_theta * ray.dir_y,
+                              pose.sin_theta * ray.dir_x + pose.cos_theta * ray.dir_y, ray.dir_z);
+    const double t_max = to_floor ? camera_.viewpointHeight() / -dir.z() : std::numeric_limits<double>::infinity();
+    return field_.goalHit(origin, dir, t_max);
+  };
+  if (ray.region == PixelRegion::kAboveHorizon) return goalHit(false);
   double fx, fy;
   pose.apply(ray.ground_x_m, ray.ground_y_m, &fx, &fy);
   // A ray can only pass through a goal box if it reaches beyond a goal line.
   if (std::abs(fx) >= field_.halfLength() || std::abs(pose.x_m) >= field_.halfLength()) {
-    const double t_floor = camera_.viewpointHeight() / -dir.z();
-    const ColorClass goal = field_.goalHit(origin, dir, t_floor);
+    const ColorClass goal = goalHit(true);
     if (goal != kUnknown) return goal;
   }
   if (kTellLines) return field_.floorClass(fx, fy);
