@@ -33,6 +33,24 @@ bool hypotWithin(double a, double b, double lo, double hi) {
   return r <= hi && r >= lo;
 }
 
+// Side of the cells of the line grid, in metres: lines are 0.125 m wide, so that most cells of
+// the carpet lie between lines.
+constexpr double kLineGridCellM = 0.1;
+
+// Smallest and largest distance from the origin to a point of [x0, x1] x [y0, y1].
+void distanceRange(double x0, double x1, double y0, double y1, double* lo, double* hi) {
+  const double nx = std::clamp(0.0, x0, x1), ny = std::clamp(0.0, y0, y1);
+  *lo = std::hypot(nx, ny);
+  *hi = std::hypot(std::max(std::abs(x0), std::abs(x1)), std::max(std::abs(y0), std::abs(y1)));
+}
+
+// Some point of the rectangle has its distance from the origin within [lo, hi].
+bool annulusMeets(double x0, double x1, double y0, double y1, double lo, double hi) {
+  double near, far;
+  distanceRange(x0, x1, y0, y1, &near, &far);
+  return near <= hi && far >= lo;
+}
+
 }  // namespace
 
 FieldModel::FieldModel(const FieldCalibration& field)
@@ -49,9 +67,52 @@ FieldModel::FieldModel(const FieldCalibration& field)
     goal_min_[i] = Eigen::Vector3d(std::min(x_near, x_far), -field.goal_width_m / 2, 0.0);
     goal_max_[i] = Eigen::Vector3d(std::max(x_near, x_far), field.goal_width_m / 2, field.goal_height_m);
   }
+  // The grid covers the quadrant with whole cells; a point's cell is found by truncating
+  // coordinate / cell side, so each cell is tested slightly enlarged against rounding.
+  grid_inverse_cell_m_ = 1.0 / kLineGridCellM;
+  const size_t columns = static_cast<size_t>(half_length_m_ * grid_inverse_cell_m_) + 1;
+  grid_rows_ = static_cast<size_t>(half_width_m_ * grid_inverse_cell_m_) + 1;
+  line_may_cross_.assign(columns * grid_rows_, 0);
+  const double slack = 1e-6 * std::max(1.0, std::max(half_length_m_, half_width_m_));
+  for (size_t i = 0; i < columns; ++i) {
+    for (size_t j = 0; j < grid_rows_; ++j) {
+      const double x0 = static_cast<double>(i) * kLineGridCellM, y0 = static_cast<double>(j) * kLineGridCellM;
+      line_may_cross_[i * grid_rows_ + j] =
+          lineMayCross(x0 - slack, x0 + kLineGridCellM + slack, y0 - slack, y0 + kLineGridCellM + slack);
+    }
+  }
 }
 
-bool FieldModel::isLine(double x_m, double y_m) const {
+bool FieldModel::lineMayCross(double x0, double x1, double y0, double y1) const {
+  const double lw = field_.line_width_m;
+  const double hl = half_length_m_;
+  const double hw = half_width_m_;
+  if (y1 >= hw - lw || x1 >= hl - lw) return true;  // side and goal lines
+  if (x0 <= lw / 2) return true;                    // halfway line
+  const double r = field_.center_circle_radius_m;
+  if (annulusMeets(x0, x1, y0, y1, r - lw, r)) return true;
+  for (const auto& [depth, width] : {std::make_pair(field_.goal_area_depth_m, field_.goal_area_width_m),
+                                     std::make_pair(field_.penalty_area_depth_m, field_.penalty_area_width_m)}) {
+    const double x_inner = hl - depth;
+    if (y0 <= width / 2 && x1 >= x_inner && x0 <= x_inner + lw) return true;
+    if (x1 >= x_inner && y0 <= width / 2 && y1 >= width / 2 - lw) return true;
+  }
+  const double corner = field_.corner_arc_radius_m;
+  if (annulusMeets(hl - x1, hl - x0, hw - y1, hw - y0, corner - lw, corner)) return true;
+  if (field_.penalty_mark_distance_m) {
+    const double mark = hl - *field_.penalty_mark_distance_m;
+    if (annulusMeets(x0 - mark, x1 - mark, y0, y1, -1.0, lw / 2)) return true;
+  }
+  return false;
+}
+
+double FieldModel::lineFreeFraction() const {
+  const auto crossed = std::count(line_may_cross_.begin(), line_may_cross_.end(), uint8_t{1});
+  return 1.0 - static_cast<double>(crossed) / static_cast<double>(line_may_cross_.size());
+}
+
+// Every test here has its interval form in lineMayCross: change both together.
+bool FieldModel::isLineUncached(double x_m, double y_m) const {
   const double ax = std::abs(x_m);
   const double ay = std::abs(y_m);
   const double lw = field_.line_width_m;

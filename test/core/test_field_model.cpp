@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
+#include <vector>
 
 #include "act_color/core/field_model.hpp"
 #include "test_util.hpp"
@@ -81,4 +83,51 @@ TEST(FieldModel, GoalsAreThreeDimensionalBoxesBehindTheGoalLines) {
   f.goalBox(kYellow, &lo, &hi);
   EXPECT_TRUE(lo.isApprox(Eigen::Vector3d(9.0, -1.0, 0.0)));
   EXPECT_TRUE(hi.isApprox(Eigen::Vector3d(9.5, 1.0, 1.0)));
+}
+
+// isLine answers most points from its grid of cells no line crosses: the grid must never hide a
+// line. Checked on the contract's field and on fields whose markings fall across cells
+// differently, at random points and at points on and around every cell boundary.
+TEST(FieldModel, LineGridNeverHidesALine) {
+  std::vector<act_color::core::FieldCalibration> fields;
+  fields.push_back(act_color::test::contractCalibration().field);
+  auto odd = fields.front();
+  odd.line_width_m = 0.05;
+  odd.center_circle_radius_m = 1.234;
+  odd.corner_arc_radius_m = 0.333;
+  odd.goal_area_depth_m = 0.777;
+  odd.penalty_mark_distance_m = 2.913;
+  odd.length_m = 17.93;
+  odd.width_m = 11.87;
+  fields.push_back(odd);
+  auto wide = fields.front();
+  wide.line_width_m = 0.31;
+  wide.corner_arc_radius_m = 0.0;
+  wide.penalty_mark_distance_m.reset();
+  fields.push_back(wide);
+  std::mt19937 rng(7);
+  for (const auto& calibration : fields) {
+    const FieldModel f(calibration);
+    const double hl = calibration.length_m / 2 + 0.05, hw = calibration.width_m / 2 + 0.05;
+    std::uniform_real_distribution<double> x(-hl, hl), y(-hw, hw);
+    int lines = 0;
+    for (int n = 0; n < 400000; ++n) {
+      const double px = x(rng), py = y(rng);
+      ASSERT_EQ(f.isLine(px, py), f.isLineUncached(px, py)) << px << ", " << py;
+      lines += f.isLine(px, py);
+    }
+    EXPECT_GT(lines, 1000);  // the random points do meet lines
+    // On and next to the cell boundaries (multiples of 0.1 m), along lines across the field.
+    for (int i = 0; i <= static_cast<int>(hl * 10) + 1; ++i) {
+      for (const double eps : {-1e-9, 0.0, 1e-9}) {
+        const double b = i * 0.1 + eps;
+        for (double t = -hw; t <= hw; t += 0.00731) {
+          ASSERT_EQ(f.isLine(b, t), f.isLineUncached(b, t)) << b << ", " << t;
+          ASSERT_EQ(f.isLine(t * hl / hw, b * hw / hl), f.isLineUncached(t * hl / hw, b * hw / hl));
+        }
+      }
+    }
+    EXPECT_GT(f.lineFreeFraction(), 0.5);  // and it answers most of the field
+  }
+  EXPECT_FALSE(FieldModel(fields.front()).isLine(std::nan(""), 0.0));
 }

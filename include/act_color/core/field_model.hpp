@@ -1,6 +1,9 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/types.hpp"
@@ -19,7 +22,20 @@ class FieldModel {
   // Class of the floor at (x, y): kWhite on a line or mark, kGreen on carpet or margin,
   // kUnknown beyond the margin. Goals are not part of the floor (see goalHit).
   ColorClass floorClass(double x_m, double y_m) const;
-  bool isLine(double x_m, double y_m) const;
+  // On a line or mark. Looks up a grid of the field first: most floor points lie in cells that no
+  // line crosses. Always equal to isLineUncached.
+  bool isLine(double x_m, double y_m) const {
+    const double ax = std::abs(x_m);
+    const double ay = std::abs(y_m);
+    if (!(ax <= half_length_m_ && ay <= half_width_m_)) return false;  // margin (or NaN): no markings
+    const size_t cell =
+        static_cast<size_t>(ax * grid_inverse_cell_m_) * grid_rows_ + static_cast<size_t>(ay * grid_inverse_cell_m_);
+    return line_may_cross_[cell] && isLineUncached(x_m, y_m);
+  }
+  // isLine from the line geometry alone (for tests).
+  bool isLineUncached(double x_m, double y_m) const;
+  // Fraction of the grid's cells that no line crosses.
+  double lineFreeFraction() const;
   // Inside the carpet (playable field plus margin).
   bool onCarpet(double x_m, double y_m) const {
     return std::abs(x_m) <= carpet_half_length_m_ && std::abs(y_m) <= carpet_half_width_m_;
@@ -44,6 +60,15 @@ class FieldModel {
   double carpet_half_width_m_;
   Eigen::Vector3d goal_min_[2];  // [0] yellow, [1] blue
   Eigen::Vector3d goal_max_[2];
+
+  // May a line or mark cross the rectangle [x0, x1] x [y0, y1] of the quadrant x, y >= 0? False
+  // only when isLineUncached is false everywhere in it: every test of isLineUncached, on intervals.
+  bool lineMayCross(double x0, double x1, double y0, double y1) const;
+  // The quadrant [0, half length] x [0, half width] (the markings are symmetric about both axes)
+  // in square cells, column-major; 1 where a line may cross the cell.
+  std::vector<uint8_t> line_may_cross_;
+  double grid_inverse_cell_m_ = 0.0;
+  size_t grid_rows_ = 0;
 };
 
 }  // namespace core
