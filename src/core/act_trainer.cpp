@@ -56,6 +56,29 @@ struct StridedPixels {
   int du_, dv_;
 };
 
+// Pixels of the removal step by index, column and row. PackedPixels: rgb8 or bgr8 rows without
+// padding, where a pixel's bytes lie at 3 x its index; AnyPixels: every format and row step.
+template <bool kBgr>
+struct PackedPixels {
+  const uint8_t* data;
+  const uint8_t* address(uint32_t pixel, int, int) const { return data + 3 * static_cast<size_t>(pixel); }
+  void color(uint32_t pixel, int, int, uint8_t out[3]) const {
+    const uint8_t* p = address(pixel, 0, 0);
+    out[0] = p[kBgr ? 2 : 0];
+    out[1] = p[1];
+    out[2] = p[kBgr ? 0 : 2];
+  }
+};
+
+struct AnyPixels {
+  const ImageView& image;
+  const uint8_t* address(uint32_t, int u, int v) const {
+    const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
+    return image.data + static_cast<size_t>(v) * image.step + static_cast<size_t>(u) * bytes_per_pixel;
+  }
+  void color(uint32_t, int u, int v, uint8_t out[3]) const { image.color(u, v, out); }
+};
+
 }  // namespace
 
 void ActParams::validate() const {
@@ -478,12 +501,26 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   candidates_.clear();
   for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
     const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
-    for (uint32_t j = samples.sector_begin[sector]; j < samples.sector_begin[sector + 1]; ++j) {
-      if (!ExpectedClassModel::mayBeOffField(samples.samples[j].range_m, safe_range)) break;
-      candidates_.push_back(&samples.samples[j]);
-    }
+    const auto first = samples.samples.begin() + samples.sector_begin[sector];
+    const auto last = samples.samples.begin() + samples.sector_begin[sector + 1];
+    candidates_.insert(candidates_.end(), first, std::partition_point(first, last, [&](const RemovalSample& sample) {
+                         return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
+                       }));
   }
-  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
+  const bool packed = image.step == 3 * static_cast<size_t>(width);
+  if (packed && image.format == PixelFormat::kRgb8) {
+    removeOffField(PackedPixels<false>{image.data}, transform, stats);
+  } else if (packed && image.format == PixelFormat::kBgr8) {
+    removeOffField(PackedPixels<true>{image.data}, transform, stats);
+  } else {
+    removeOffField(AnyPixels{image}, transform, stats);
+  }
+  ++revision_;
+  return stats;
+}
+
+template <class Pixels>
+void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats) {
   // |mu_k - c| > xi * sigma_k, compared as squared distances in float.
   std::array<Eigen::Vector3f, kNumClasses> remove_mean;
   std::array<float, kNumClasses> remove_radius_sq;
@@ -492,26 +529,25 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     const double radius = params_.xi * clusters_[k].sigma();
     remove_radius_sq[k] = static_cast<float>(radius * radius);
   }
-  // They lie far apart in memory: fetch their ray and pixel some samples ahead.
+  // The samples lie far apart in memory: their ray and pixel are fetched some samples ahead.
   constexpr size_t kAhead = 16;
   const size_t candidates = candidates_.size();
   for (size_t j = 0; j < candidates; ++j) {
     if (j + kAhead < candidates) {
-      const RemovalSample& ahead = *candidates_[j + kAhead];
-      model_.prefetchRemoval(ahead.pixel);
-      __builtin_prefetch(image.data + ahead.v * image.step + ahead.u * bytes_per_pixel);
+      const RemovalSample& ahead = candidates_[j + kAhead];
+      model_.prefetchRay(ahead.pixel);
+      __builtin_prefetch(pixels.address(ahead.pixel, ahead.u, ahead.v));
     }
     // The color first: most colors seen off the field are mapped to no class, and then whether
     // the pixel really is off the field (a ray cast) does not matter.
-    const RemovalSample& sample = *candidates_[j];
-    const size_t i = sample.pixel;
+    const RemovalSample& sample = candidates_[j];
     uint8_t c[3];
-    image.color(sample.u, sample.v, c);
+    pixels.color(sample.pixel, sample.u, sample.v, c);
     const uint32_t cell = lut_.index(c[0], c[1], c[2]);
     if (!mapped(cell)) continue;  // the bitmap fits the L1 cache, the table does not
     const uint8_t k = lut_.at(cell);
     if (k >= kNumClasses) continue;
-    if (!model_.offField(i, transform)) continue;
+    if (!model_.offField(sample.pixel, transform)) continue;
     ++stats.remove_candidates;
     if (params_.evidence_removal_ratio > 0) {
       Evidence& e = evidence(cell);
@@ -534,8 +570,6 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       ++stats.removed[k];
     }
   }
-  ++revision_;
-  return stats;
 }
 
 const ActTrainer::RemovalSamples& ActTrainer::removalSamples(size_t start) {

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <functional>
+#include <opencv2/imgproc.hpp>
+
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/metrics.hpp"
 #include "act_color/core/segmenter.hpp"
@@ -350,6 +353,38 @@ TEST_F(ActTrainerTest, SameSeedSameTable) {
   ActTrainer c(cal, p);
   c.bootstrap(view(frame.rgb), pose, 5);
   EXPECT_NE(a.lut().table(), c.lut().table());
+}
+
+// The removal step reads packed rgb8 and bgr8 images by pixel index and other layouts by row and
+// column: the same picture gives the same table in every layout.
+TEST_F(ActTrainerTest, TheTableDoesNotDependOnTheImageLayout) {
+  const auto bright = paintFlatFrame(model, pose, 1.0, 1);
+  const auto dark = paintFlatFrame(model, pose, 0.8, 2);
+  auto run = [&](const std::function<ImageView(const cv::Mat&)>& layout) {
+    ActTrainer trainer(cal);
+    uint32_t remove_candidates = 0;
+    for (int n = 0; n < 8; ++n) remove_candidates += trainer.cycle(layout(bright.rgb), pose).remove_candidates;
+    for (int n = 0; n < 8; ++n) remove_candidates += trainer.cycle(layout(dark.rgb), pose).remove_candidates;
+    return std::make_pair(trainer.lut().table(), remove_candidates);
+  };
+  const auto packed = run([](const cv::Mat& rgb) { return view(rgb); });
+  EXPECT_GT(packed.second, 0u);  // the removal step had colors to look at
+  std::vector<cv::Mat> keep;     // the converted images outlive their views
+  const auto bgr = run([&](const cv::Mat& rgb) {
+    keep.emplace_back();
+    cv::cvtColor(rgb, keep.back(), cv::COLOR_RGB2BGR);
+    return ImageView::fromMat(keep.back(), PixelFormat::kBgr8);
+  });
+  const auto padded = run([&](const cv::Mat& rgb) {
+    keep.emplace_back(rgb.rows, rgb.cols + 7, CV_8UC3, cv::Scalar::all(0));
+    cv::Mat roi = keep.back()(cv::Rect(0, 0, rgb.cols, rgb.rows));
+    rgb.copyTo(roi);
+    const ImageView v = view(roi);
+    EXPECT_GT(v.step, 3u * static_cast<size_t>(v.width));
+    return v;
+  });
+  EXPECT_EQ(bgr, packed);
+  EXPECT_EQ(padded, packed);
 }
 
 TEST_F(ActTrainerTest, ANewColorSpaceStartsAFreshTable) {

@@ -196,7 +196,10 @@ class ActTrainer {
   const RemovalSamples& removalSamples(size_t start);
   std::unordered_map<size_t, RemovalSamples> removal_samples_;
   std::array<double, ExpectedClassModel::kRemovalSectors> sector_safe_range_{};
-  std::vector<const RemovalSample*> candidates_;  // scratch: this cycle's samples that may be off the field
+  std::vector<RemovalSample> candidates_;  // scratch: this cycle's samples that may be off the field
+  // 2.4 on candidates_, reading their colors through `pixels` (see act_trainer.cpp).
+  template <class Pixels>
+  void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
   int removal_samples_stride_ = 0;
 };
 
