@@ -12,6 +12,11 @@ ColorLut::ColorLut(int bits_per_channel, ColorSpace space)
   if (bits_per_channel < 1 || bits_per_channel > 8) {
     throw std::invalid_argument("lut_bits must be in [1, 8], is " + std::to_string(bits_per_channel));
   }
+  for (uint32_t c = 0; c < 256; ++c) {
+    channel_index_[0][c] = cellIndex(c >> shift_, 0, 0);
+    channel_index_[1][c] = cellIndex(0, c >> shift_, 0);
+    channel_index_[2][c] = cellIndex(0, 0, c >> shift_);
+  }
   clear();
 }
 

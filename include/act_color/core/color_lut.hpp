@@ -19,9 +19,9 @@ class ColorLut {
   ColorSpace colorSpace() const { return space_; }
   size_t size() const { return table_.size(); }
 
+  // cellIndex(c0 >> (8 - bits), c1 >> (8 - bits), c2 >> (8 - bits)), from per-channel tables.
   uint32_t index(uint8_t c0, uint8_t c1, uint8_t c2) const {
-    return cellIndex(static_cast<uint32_t>(c0 >> shift_), static_cast<uint32_t>(c1 >> shift_),
-                     static_cast<uint32_t>(c2 >> shift_));
+    return channel_index_[0][c0] | channel_index_[1][c1] | channel_index_[2][c2];
   }
   // The cell of per-channel cell numbers i0, i1, i2 in [0, 2^bits).
   uint32_t cellIndex(uint32_t i0, uint32_t i1, uint32_t i2) const { return (i0 << (2 * bits_)) | (i1 << bits_) | i2; }
@@ -49,6 +49,8 @@ class ColorLut {
   ColorSpace space_;
   std::vector<uint8_t> table_;
   std::array<uint32_t, kNumClasses> counts_{};  // cells per class id < kNumClasses
+  // Each channel value's share of its cell index (a few loads instead of variable shifts).
+  std::array<std::array<uint32_t, 256>, 3> channel_index_{};
 };
 
 }  // namespace core
