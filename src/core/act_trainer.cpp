@@ -28,6 +28,9 @@ constexpr uint32_t kNeighbourhoodRefreshCycles = 8;
 // Largest ratio between the per-channel gains of a change of light (see cycle()).
 constexpr double kMaxGainSpread = 2.5;
 
+// Pixels the cluster and addition steps fetch ahead of the one they look at.
+constexpr int kSamplesAhead = 16;
+
 // Every stride-th pixel from `start`, with its column and row kept up to date without a division.
 struct StridedPixels {
   StridedPixels(size_t start, int stride, int width)
@@ -412,15 +415,30 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     return c;
   };
 
+  // Every stride-th pixel from a random start. The pixels lie far apart in memory: the ray and,
+  // in images without row padding, the color of the pixel kSamplesAhead strides ahead are fetched.
+  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
+  const uint8_t* packed_data = image.step == bytes_per_pixel * width ? image.data : nullptr;
+  auto everyNth = [&](int stride, auto&& visit) {
+    const size_t ahead = static_cast<size_t>(kSamplesAhead) * stride;
+    for (StridedPixels p(randomStart(stride), stride, width); p.i < pixels; p.next()) {
+      if (p.i + ahead < pixels) {
+        model_.prefetchRay(p.i + ahead);
+        if (packed_data) __builtin_prefetch(packed_data + (p.i + ahead) * bytes_per_pixel);
+      }
+      visit(p);
+    }
+  };
+
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
-  for (StridedPixels p(randomStart(params_.cluster_stride), params_.cluster_stride, width); p.i < pixels; p.next()) {
+  everyNth(params_.cluster_stride, [&](const StridedPixels& p) {
     const uint8_t expected_k = expected(p);
-    if (expected_k == kUnknown || expected_k >= kNumClasses) continue;
+    if (expected_k == kUnknown || expected_k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
     samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
-  }
+  });
   const ClusterParams cluster_params = clusterParams();
   if (params_.robust_clusters) {
     // Colors that firmly belong to another class train neither cluster nor table for k.
@@ -484,14 +502,14 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   const int add_stride =
       stats.light_change ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
   add_weight_ = add_stride;
-  for (StridedPixels p(randomStart(add_stride), add_stride, width); p.i < pixels; p.next()) {
+  everyNth(add_stride, [&](const StridedPixels& p) {
     const uint8_t k = expected(p);
-    if (k == kUnknown || k >= kNumClasses) continue;
+    if (k == kUnknown || k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
     const uint8_t trained = trainedClass(k, c);
     stats.added[trained] += addColor(c, trained);
-  }
+  });
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
   const size_t start = randomStart(params_.remove_stride);

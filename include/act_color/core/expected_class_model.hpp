@@ -65,7 +65,7 @@ class ExpectedClassModel {
   float removalRange(size_t pixel_index) const { return removal_range_m_[pixel_index]; }
   static bool mayBeOffField(float removal_range_m, double safe_range_m) { return !(removal_range_m < safe_range_m); }
   size_t pixels() const { return removal_range_m_.size(); }
-  // Hints the cache about the ray of a pixel (< pixels()) the removal step will look at soon.
+  // Hints the cache about the ray of a pixel (< pixels()) that will be looked at soon.
   void prefetchRay(size_t pixel_index) const { __builtin_prefetch(&camera_.ray(pixel_index)); }
   // geometricClass(pixel_index, pose) == kUnknown, computed the same way but without telling lines
   // from carpet.
