@@ -242,21 +242,33 @@ uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
   return (color - green.mean()).norm() > params_.zeta * green.sigma() ? static_cast<uint8_t>(kBlack) : k;
 }
 
+void ActTrainer::prepareNearestMean() {
+  for (auto& boundaries : mean_boundaries_) boundaries.clear();
+  if (!params_.nearest_mean) return;
+  // The rule's squared distance is (c - m)' A (c - m), the intensity difference weighted by
+  // kIntensityWeight: a line in a shadow stays nearer to white than to green, a mixture of two
+  // classes is split at its middle. In YUV A = diag(w, 1, 1); in RGB A = I - (1 - w) / 3 J (J: all
+  // ones), which removes 1 - w of the squared intensity difference (sum / 3) times 3.
+  // Mean j is nearer than mean k when 2 c' A (m_k - m_j) < m_k' A m_k - m_j' A m_j.
+  Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
+  if (lut_.colorSpace() == ColorSpace::kYuv) {
+    a(0, 0) = kIntensityWeight;
+  } else {
+    a -= Eigen::Matrix3d::Constant((1.0 - kIntensityWeight) / 3.0);
+  }
+  for (int k = 1; k < kNumClasses; ++k) {
+    const Eigen::Vector3d& own = clusters_[k].mean();
+    for (int j = 1; j < kNumClasses; ++j) {
+      if (j == k || !clusters_[j].trained()) continue;
+      const Eigen::Vector3d& other = clusters_[j].mean();
+      mean_boundaries_[k].push_back({2.0 * a * (own - other), own.dot(a * own) - other.dot(a * other)});
+    }
+  }
+}
+
 bool ActTrainer::nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const {
-  if (!params_.nearest_mean) return false;
-  const bool yuv = lut_.colorSpace() == ColorSpace::kYuv;
-  // Squared distance with the intensity difference weighted by kIntensityWeight: a line in a
-  // shadow stays nearer to white than to green, a mixture of two classes is split at its middle.
-  auto distanceSq = [&](const Eigen::Vector3d& mean) {
-    const Eigen::Vector3d d = color - mean;
-    if (yuv) return kIntensityWeight * d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-    const double intensity = d.sum() / 3.0;
-    return d.squaredNorm() - 3.0 * (1.0 - kIntensityWeight) * intensity * intensity;
-  };
-  const double own = distanceSq(clusters_[k].mean());
-  for (int j = 1; j < kNumClasses; ++j) {
-    if (j == k || !clusters_[j].trained()) continue;
-    if (distanceSq(clusters_[j].mean()) < own) return true;
+  for (const MeanBoundary& b : mean_boundaries_[k]) {
+    if (b.normal.dot(color) < b.offset) return true;
   }
   return false;
 }
@@ -502,6 +514,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   const int add_stride =
       stats.light_change ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
   add_weight_ = add_stride;
+  prepareNearestMean();
   everyNth(add_stride, [&](const StridedPixels& p) {
     const uint8_t k = expected(p);
     if (k == kUnknown || k >= kNumClasses) return;

@@ -128,7 +128,9 @@ class ActTrainer {
   // 2.3 for one color; returns the number of cells that changed to class k.
   uint32_t addColor(const uint8_t c[3], uint8_t k);
   // ActParams::nearest_mean: another trained cluster's mean is nearer to the color than k's.
+  // Uses the boundaries from prepareNearestMean(), made after this cycle's cluster update.
   bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
+  void prepareNearestMean();
   // Leaves out of k's cluster samples the colors within zeta * sigma of the green or the black
   // cluster (the carpet, the chassis and robots; both updated first) and nearer to it than to k's
   // (in sigmas; any such color while k is untrained). Not white: its sphere is wide under uneven
@@ -166,6 +168,14 @@ class ActTrainer {
   std::mt19937 rng_;
   uint64_t revision_ = 0;
   bool space_known_ = false;
+  // Between the means of class k and of each other trained class j, the boundary of the nearest-
+  // mean rule: j's mean is nearer to color c than k's when normal . c < offset (the rule's
+  // distance is a quadratic form, so the boundary is a plane).
+  struct MeanBoundary {
+    Eigen::Vector3d normal;
+    double offset;
+  };
+  std::array<std::vector<MeanBoundary>, kNumClasses> mean_boundaries_;
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
   std::vector<uint8_t> warped_;
