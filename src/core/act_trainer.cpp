@@ -76,8 +76,7 @@ struct PackedPixels {
 struct AnyPixels {
   const ImageView& image;
   const uint8_t* address(uint32_t, int u, int v) const {
-    const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
-    return image.data + static_cast<size_t>(v) * image.step + static_cast<size_t>(u) * bytes_per_pixel;
+    return image.data + static_cast<size_t>(v) * image.step + static_cast<size_t>(u) * bytesPerPixel(image.format);
   }
   void color(uint32_t, int u, int v, uint8_t out[3]) const { image.color(u, v, out); }
 };
@@ -398,8 +397,8 @@ void ActTrainer::checkImage(const ImageView& image) const {
       << camera.height();
     throw std::invalid_argument(s.str());
   }
-  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
-  if (image.step < bytes_per_pixel * image.width) throw std::invalid_argument("image row step is too small");
+  if (image.step < bytesPerPixel(image.format) * image.width)
+    throw std::invalid_argument("image row step is too small");
   if (image.format == PixelFormat::kUyvy && image.width % 2 != 0)
     throw std::invalid_argument("yuv422 needs an even width");
 }
@@ -429,7 +428,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 
   // Every stride-th pixel from a random start. The pixels lie far apart in memory: the ray and,
   // in images without row padding, the color of the pixel kSamplesAhead strides ahead are fetched.
-  const size_t bytes_per_pixel = image.format == PixelFormat::kUyvy ? 2 : 3;
+  const size_t bytes_per_pixel = bytesPerPixel(image.format);
   const uint8_t* packed_data = image.step == bytes_per_pixel * width ? image.data : nullptr;
   auto everyNth = [&](int stride, auto&& visit) {
     const size_t ahead = static_cast<size_t>(kSamplesAhead) * stride;
@@ -538,10 +537,9 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
                          return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
                        }));
   }
-  const bool packed = image.step == 3 * static_cast<size_t>(width);
-  if (packed && image.format == PixelFormat::kRgb8) {
+  if (packed_data && image.format == PixelFormat::kRgb8) {
     removeOffField(PackedPixels<false>{image.data}, transform, stats);
-  } else if (packed && image.format == PixelFormat::kBgr8) {
+  } else if (packed_data && image.format == PixelFormat::kBgr8) {
     removeOffField(PackedPixels<true>{image.data}, transform, stats);
   } else {
     removeOffField(AnyPixels{image}, transform, stats);

@@ -7,15 +7,15 @@
 namespace act_color {
 namespace core {
 
-ColorLut::ColorLut(int bits_per_channel, ColorSpace space)
-    : bits_(bits_per_channel), shift_(8 - bits_per_channel), space_(space) {
+ColorLut::ColorLut(int bits_per_channel, ColorSpace space) : bits_(bits_per_channel), space_(space) {
   if (bits_per_channel < 1 || bits_per_channel > 8) {
     throw std::invalid_argument("lut_bits must be in [1, 8], is " + std::to_string(bits_per_channel));
   }
+  const int shift = 8 - bits_per_channel;
   for (uint32_t c = 0; c < 256; ++c) {
-    channel_index_[0][c] = cellIndex(c >> shift_, 0, 0);
-    channel_index_[1][c] = cellIndex(0, c >> shift_, 0);
-    channel_index_[2][c] = cellIndex(0, 0, c >> shift_);
+    channel_index_[0][c] = cellIndex(c >> shift, 0, 0);
+    channel_index_[1][c] = cellIndex(0, c >> shift, 0);
+    channel_index_[2][c] = cellIndex(0, 0, c >> shift);
   }
   clear();
 }

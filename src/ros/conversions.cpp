@@ -19,7 +19,7 @@ bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::stri
     *error = "unsupported encoding '" + image.encoding + "' (expected rgb8, bgr8 or yuv422)";
     return false;
   }
-  const size_t bytes_per_pixel = format == core::PixelFormat::kUyvy ? 2 : 3;
+  const size_t bytes_per_pixel = core::bytesPerPixel(format);
   if (image.width == 0 || image.height == 0) {
     *error = "empty image";
     return false;

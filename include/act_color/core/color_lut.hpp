@@ -45,7 +45,6 @@ class ColorLut {
 
  private:
   int bits_;
-  int shift_;
   ColorSpace space_;
   std::vector<uint8_t> table_;
   std::array<uint32_t, kNumClasses> counts_{};  // cells per class id < kNumClasses

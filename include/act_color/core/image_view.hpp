@@ -16,6 +16,8 @@ enum class PixelFormat : uint8_t { kRgb8 = 0, kBgr8 = 1, kUyvy = 2 };
 enum class ColorSpace : uint8_t { kRgb = 0, kYuv = 1 };
 
 ColorSpace nativeColorSpace(PixelFormat format);
+// Bytes per pixel of a row: 2 for yuv422 (UYVY, two pixels in 4 bytes), 3 for rgb8 and bgr8.
+inline size_t bytesPerPixel(PixelFormat format) { return format == PixelFormat::kUyvy ? 2 : 3; }
 // Parses a ROS encoding string; false for anything unsupported.
 bool pixelFormatFromEncoding(const std::string& encoding, PixelFormat* format);
 const char* encodingName(PixelFormat format);
