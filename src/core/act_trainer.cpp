@@ -25,9 +25,6 @@ constexpr double kIntensityWeight = 0.1;
 // A cell confirmed again within this many cycles does not fill its neighbourhood again.
 constexpr uint32_t kNeighbourhoodRefreshCycles = 8;
 
-// Largest ratio between the per-channel gains of a change of light (see cycle()).
-constexpr double kMaxGainSpread = 2.5;
-
 // Pixels the cluster and addition steps fetch ahead of the one they look at.
 constexpr int kSamplesAhead = 16;
 
@@ -96,6 +93,7 @@ void ActParams::validate() const {
   requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
   requireRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
   requireRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
+  requireRange("reacquire_cycles", reacquire_cycles, 0, 1000);
 }
 
 void ActParams::switchOffExtensions() {
@@ -107,6 +105,7 @@ void ActParams::switchOffExtensions() {
   robots_train_black = false;
   nearest_mean = false;
   evidence_removal_ratio = 0;
+  reacquire_cycles = 0;
 }
 
 ActParams ActParams::paper() {
@@ -129,6 +128,7 @@ void ActTrainer::reset(ColorSpace space) {
   neighbour_only_.assign(lut_.size(), 0);
   evidence_.assign(lut_.size(), Evidence{});
   for (auto& cluster : clusters_) cluster.reset(255.0);
+  light_.reset();
   space_known_ = true;
 }
 
@@ -155,6 +155,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   confirmed_.assign(lut_.size(), 0);
   neighbour_only_.assign(lut_.size(), 0);
   evidence_.assign(lut_.size(), Evidence{});
+  light_.reset();
   space_known_ = true;
 }
 
@@ -164,6 +165,7 @@ ClusterParams ActTrainer::clusterParams() const {
   p.sigma_min = params_.sigma_min;
   p.zeta = params_.zeta;
   p.seed_from_first_samples = params_.seed_clusters;
+  p.reacquire_cycles = params_.reacquire_cycles;
   return p;
 }
 
@@ -296,13 +298,17 @@ bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t curre
   return (other.mean() - color).norm() / other.sigma() <= (own.mean() - color).norm() / own.sigma();
 }
 
-void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot) {
+void ActTrainer::applyLightChange(const LightModel::Map& map) {
   const ClusterParams cluster_params = clusterParams();
-  for (auto& cluster : clusters_) cluster.applyGain(gain, pivot, cluster_params);
+  for (auto& cluster : clusters_) {
+    const double scale = std::clamp(map.maxSlope(cluster.mean(), cluster.sigma()), 0.1, 10.0);
+    cluster.applyLightChange(map.apply(cluster.mean()), scale, cluster_params);
+  }
   // Every mapped cell moves to where its colors are under the new light: the cells whose centres
-  // lie in the image of the cell's box of colors take its class, or, when a gain below 1 shrinks
-  // the box between two centres, the cell of its mapped centre. Under a gain above 1 the moved
-  // cells thus leave no holes between them, and a gain near 1 does not dilate the classes. Moved
+  // lie in the image of the cell's box of colors (a box again: the map is per channel) take its
+  // class, or, when the map shrinks the box between two centres, the cell of its mapped centre.
+  // Where the map stretches colors the moved cells thus leave no holes between them, and a map
+  // near the identity does not dilate the classes. Moved
   // cells win over what was there (stale mappings of the old light), the rest stays.
   const int bits = lut_.bitsPerChannel();
   const int cells = 1 << bits;
@@ -317,9 +323,9 @@ void ActTrainer::applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vect
     int first[3], last[3];
     const uint32_t channel_cells[3] = {cell >> (2 * bits), (cell >> bits) & mask, cell & mask};
     for (int ch = 0; ch < 3; ++ch) {
-      // The cell's colors map to [lo, hi) under the new light (gains are positive).
-      const double lo = pivot[ch] + (channel_cells[ch] * width - pivot[ch]) * gain[ch];
-      const double hi = pivot[ch] + ((channel_cells[ch] + 1) * width - pivot[ch]) * gain[ch];
+      // The cell's colors map to [lo, hi) under the new light (the map is non-decreasing).
+      const double lo = map.at(ch, channel_cells[ch] * width);
+      const double hi = map.at(ch, (channel_cells[ch] + 1) * width);
       // Centres (i + 0.5) * width in [lo, hi).
       first[ch] = static_cast<int>(std::ceil(lo / width - 0.5));
       last[ch] = static_cast<int>(std::ceil(hi / width - 0.5)) - 1;
@@ -443,13 +449,17 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
+  chassis_samples_.clear();
   everyNth(params_.cluster_stride, [&](const StridedPixels& p) {
     const uint8_t expected_k = expected(p);
     if (expected_k == kUnknown || expected_k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
     samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
+    if (expected_k == kBlack) chassis_samples_.emplace_back(c[0], c[1], c[2]);
   });
+  // The anchors of the light model, before any class filters its colors.
+  light_.observe(samples_[kGreen], samples_[kWhite], chassis_samples_);
   const ClusterParams cluster_params = clusterParams();
   if (params_.robust_clusters) {
     // Colors that firmly belong to another class train neither cluster nor table for k.
@@ -468,32 +478,22 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     }
   }
   const ClassCluster& green = clusters_[kGreen];
-  if (params_.light_compensation && green.trained() && samples_[kGreen].size() >= 10) {
-    Eigen::Vector3d green_mean = Eigen::Vector3d::Zero();
-    for (const auto& c : samples_[kGreen]) green_mean += c.cast<double>();
-    green_mean /= static_cast<double>(samples_[kGreen].size());
-    if ((green_mean - green.mean()).norm() > params_.zeta * green.sigma()) {
-      // Gains about the channel's zero: 0 for R, G, B and Y, 128 for the chroma channels U and V.
-      const bool yuv = lut_.colorSpace() == ColorSpace::kYuv;
-      const Eigen::Vector3d pivot = yuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
-      Eigen::Vector3d gain;
-      for (int c = 0; c < 3; ++c) {
-        const double from = green.mean()[c] - pivot[c];
-        gain[c] = std::abs(from) >= 8.0 ? (green_mean[c] - pivot[c]) / from : -1.0;
-      }
-      // A channel too close to its pivot tells nothing: it follows the largest reliable gain
-      // (in YUV, chroma scales with luma under a change of light level).
-      const double fallback = std::max(0.1, gain.maxCoeff());
-      for (int c = 0; c < 3; ++c) gain[c] = std::clamp(gain[c] < 0 ? fallback : gain[c], 0.1, 10.0);
-      // Light changes its level and, within limits, its color temperature; gains further apart
-      // than kMaxGainSpread are a change of what the camera sees (say, a poster on the carpet),
-      // which the clusters follow by themselves.
-      if (gain.maxCoeff() <= kMaxGainSpread * gain.minCoeff()) {
-        applyLightChange(gain, pivot);
-        stats.light_change = true;
-        stats.light_gain = gain.cast<float>();
-      }
+  LightModel::Map light_map;
+  if (params_.light_compensation && green.trained() && light_.hasReference() && light_.observedGreen() &&
+      (light_.greenMedian() - light_.referenceGreenMedian()).norm() > params_.zeta * green.sigma() &&
+      light_.estimate(lut_.colorSpace(), &light_map)) {
+    const Eigen::Vector3d from = light_.referenceGreenMedian();
+    const Eigen::Vector3d pivot =
+        lut_.colorSpace() == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
+    for (int c = 0; c < 3; ++c) {
+      const double d = from[c] - pivot[c];
+      stats.light_gain[c] = static_cast<float>(std::abs(d) > 1e-6 ? (light_map.at(c, from[c]) - pivot[c]) / d : 1.0);
     }
+    applyLightChange(light_map);
+    light_.rebase(light_map);
+    stats.light_change = true;
+  } else {
+    light_.follow(params_.eta);
   }
   // Green (the carpet) and black (the own chassis) first: they are seen where expected whatever
   // else is on the field, and the goals then leave out colors that are theirs (a robot in front of

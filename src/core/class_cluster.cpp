@@ -25,6 +25,7 @@ void ClassCluster::reset(double max_value) {
   sigma_ = sigma_max_;
   last_samples_ = 0;
   trained_ = false;
+  misfit_cycles_ = 0;
 }
 
 int ClassCluster::update(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params) {
@@ -60,26 +61,22 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
       last_samples_ = 0;
       return 0;
     }
-    std::vector<float> channel(colors.size());
-    Eigen::Vector3d median;
-    for (int c = 0; c < 3; ++c) {
-      for (size_t i = 0; i < colors.size(); ++i) channel[i] = colors[i][c];
-      std::nth_element(channel.begin(), channel.begin() + channel.size() / 2, channel.end());
-      median[c] = channel[channel.size() / 2];
-    }
-    std::vector<double> distance(colors.size());
-    for (size_t i = 0; i < colors.size(); ++i) distance[i] = (colors[i].cast<double>() - median).norm();
-    std::nth_element(distance.begin(), distance.begin() + distance.size() / 2, distance.end());
-    mean_ = median;
-    sigma_ = std::max(kRmsPerMedian * distance[distance.size() / 2], params.sigma_min);
-    last_samples_ = static_cast<unsigned>(colors.size());
-    trained_ = true;
+    seedRobustly(colors, params);
     return last_samples_;
   }
   inliers_.clear();
   const double radius = params.zeta * sigma_;
   for (const auto& c : colors) {
     if ((c.cast<double>() - mean_).norm() < radius) inliers_.push_back(c);
+  }
+  // Re-acquisition: the colors seen where the class is expected stopped fitting the cluster.
+  constexpr size_t kMinColorsToJudge = 4;
+  if (params.reacquire_cycles > 0 && colors.size() >= kMinColorsToJudge) {
+    misfit_cycles_ = 4 * inliers_.size() < colors.size() ? misfit_cycles_ + 1 : 0;
+    if (misfit_cycles_ >= params.reacquire_cycles) {
+      seedRobustly(colors, params);
+      return last_samples_;
+    }
   }
   if (inliers_.size() < 2) {
     last_samples_ = 0;
@@ -107,10 +104,29 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
   return last_samples_;
 }
 
-void ClassCluster::applyGain(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot, const ClusterParams& params) {
+void ClassCluster::seedRobustly(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params) {
+  std::vector<float> channel(colors.size());
+  Eigen::Vector3d median;
+  for (int c = 0; c < 3; ++c) {
+    for (size_t i = 0; i < colors.size(); ++i) channel[i] = colors[i][c];
+    std::nth_element(channel.begin(), channel.begin() + channel.size() / 2, channel.end());
+    median[c] = channel[channel.size() / 2];
+  }
+  std::vector<double> distance(colors.size());
+  for (size_t i = 0; i < colors.size(); ++i) distance[i] = (colors[i].cast<double>() - median).norm();
+  std::nth_element(distance.begin(), distance.begin() + distance.size() / 2, distance.end());
+  mean_ = median;
+  sigma_ = std::max(kRmsPerMedian * distance[distance.size() / 2], params.sigma_min);
+  last_samples_ = static_cast<unsigned>(colors.size());
+  trained_ = true;
+  misfit_cycles_ = 0;
+}
+
+void ClassCluster::applyLightChange(const Eigen::Vector3d& mean, double sigma_scale, const ClusterParams& params) {
   if (!trained_) return;
-  mean_ = (pivot + (mean_ - pivot).cwiseProduct(gain)).cwiseMax(0.0).cwiseMin(params.max_value);
-  sigma_ = std::min(std::max(sigma_ * gain.maxCoeff(), params.sigma_min), sigma_max_);
+  mean_ = mean.cwiseMax(0.0).cwiseMin(params.max_value);
+  sigma_ = std::min(std::max(sigma_ * sigma_scale, params.sigma_min), sigma_max_);
+  misfit_cycles_ = 0;
 }
 
 void ClassCluster::set(const Eigen::Vector3d& mean, double sigma, bool trained) {

@@ -12,6 +12,7 @@
 #include "act_color/core/color_lut.hpp"
 #include "act_color/core/expected_class_model.hpp"
 #include "act_color/core/image_view.hpp"
+#include "act_color/core/light_model.hpp"
 #include "act_color/core/types.hpp"
 
 namespace act_color {
@@ -45,10 +46,11 @@ struct ActParams {
   // within zeta * sigma of it) trains neither cluster nor table for the expected class. Protects
   // goals and black against robots in the goal region and wrong poses.
   bool robust_clusters = true;
-  // When green's colors jump beyond zeta * sigma (a global change of light), the per-channel gain
-  // of green's mean is applied to every cluster and to the table, so that all classes follow at
-  // once instead of re-learning from sparse samples. Gains more than 2.5 times apart are not a
-  // change of light and are left to the clusters.
+  // When the carpet's median color jumps beyond zeta * sigma of green (a global change of light or
+  // of the camera's settings), the per-channel monotone map of colors estimated by LightModel
+  // (quantiles of the carpet, line and chassis pixels before and after) moves every cluster and
+  // the table, so that all classes follow at once instead of re-learning from sparse samples.
+  // Anchors that do not move as one light would move them are left to the clusters.
   bool light_compensation = true;
   // In the cycle of such a change of light every n-th pixel is added (instead of add_stride), so
   // that what the moved table misses is filled at once.
@@ -72,6 +74,10 @@ struct ActParams {
   // in-field count is removed whatever its distance from the cluster: the color is more often
   // something else than the class (a spot-lit whitish hall floor next to white). 0: off.
   double evidence_removal_ratio = 3.0;
+  // Re-acquisition (ClusterParams::reacquire_cycles): a robust cluster whose expected colors fit it
+  // less than a quarter of the time for this many cycles in a row is seeded again from them, so no
+  // class stays lost after a change nothing foresaw. 0: off.
+  int reacquire_cycles = 3;
 
   void validate() const;
   // Every extension off: the paper's algorithm exactly.
@@ -92,7 +98,7 @@ struct CycleStats {
   uint32_t doublings = 0;                               // sigma doublings over all clusters
   bool color_space_changed = false;                     // table reset for a new color space
   bool light_change = false;                            // light compensation applied
-  Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain
+  Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain at the carpet's color
 };
 
 // The ACT algorithm (paper, section 2): one cycle per image and pose.
@@ -141,8 +147,8 @@ class ActTrainer {
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
   // The class a sample expected as k trains (robots_train_black re-routes green to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
-  // Light compensation: gains to every cluster, table cells moved by the gains.
-  void applyLightChange(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot);
+  // Light compensation: the map moves every cluster and every table cell.
+  void applyLightChange(const LightModel::Map& map);
 
   struct Evidence {
     float in_field = 0.f;
@@ -178,6 +184,8 @@ class ActTrainer {
   std::array<std::vector<MeanBoundary>, kNumClasses> mean_boundaries_;
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
+  std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
+  LightModel light_;
   std::vector<uint8_t> warped_;
   // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.
   std::vector<uint32_t> confirmed_;

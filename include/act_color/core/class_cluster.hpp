@@ -16,6 +16,11 @@ struct ClusterParams {
   // instead of blending them with eq. 2-3 (whose sigma covers the whole color cube, so that every
   // outlier of the first cycles would be added). false: the paper's eq. 4-5 from the start.
   bool seed_from_first_samples = true;
+  // Extension (re-acquisition) for updateFromInliers: when fewer than a quarter of the class's
+  // colors fit the cluster for this many cycles in a row, the expected pixels show something the
+  // cluster no longer describes (the light changed in a way no model foresaw): the cluster is
+  // seeded again from them. 0: never.
+  int reacquire_cycles = 0;
 };
 
 // Mean and standard deviation of the colors of one class, tracked over cycles (eq. 2-5).
@@ -47,9 +52,9 @@ class ClassCluster {
   // inliers used.
   unsigned updateFromInliers(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
 
-  // A global change of light, modelled as per-channel gains about a pivot (0 for R, G, B and Y;
-  // 128 for U and V): mean = pivot + gain (mean - pivot), sigma *= max gain.
-  void applyGain(const Eigen::Vector3d& gain, const Eigen::Vector3d& pivot, const ClusterParams& params);
+  // A global change of light (LightModel): the mean moves to where the light maps it, sigma
+  // scales with the map's slope there.
+  void applyLightChange(const Eigen::Vector3d& mean, double sigma_scale, const ClusterParams& params);
 
   // For restoring a saved state.
   void set(const Eigen::Vector3d& mean, double sigma, bool trained);
@@ -60,6 +65,9 @@ class ClassCluster {
   double sigma_max_ = 0.0;
   unsigned last_samples_ = 0;
   bool trained_ = false;
+  int misfit_cycles_ = 0;  // cycles in a row with too few inliers (ClusterParams::reacquire_cycles)
+  // Seeds the cluster from the per-channel median and the median distance of `colors` (>= 2).
+  void seedRobustly(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
   std::vector<Eigen::Vector3f> inliers_;  // scratch
   std::vector<double> distances_;         // scratch
 };

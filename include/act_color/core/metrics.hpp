@@ -18,6 +18,10 @@ class ClassificationMetrics {
   void clear() { confusion_ = {}; }
   // Adds another's counts (e.g. per-frame metrics into a run's).
   void merge(const ClassificationMetrics& other);
+  // Replaces the counts (e.g. a confusion computed elsewhere).
+  void setConfusion(const std::array<std::array<uint64_t, kNumClasses>, kNumClasses>& confusion) {
+    confusion_ = confusion;
+  }
 
   // confusion()[truth][predicted]
   const std::array<std::array<uint64_t, kNumClasses>, kNumClasses>& confusion() const { return confusion_; }

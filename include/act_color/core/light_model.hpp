@@ -1,0 +1,65 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+#include "act_color/core/image_view.hpp"
+
+namespace act_color {
+namespace core {
+
+// A global change of light, or of the camera's gain, contrast, gamma or white balance, maps every
+// color through one monotone (non-decreasing) function per channel. ACT estimates that function
+// from the pixels whose class the pose tells best: the carpet, the lines (eq. 1) and the own
+// chassis, whose per-channel quantiles are anchors, before (a running reference) and after.
+// Between the anchors the function is linear; beyond them it continues the nearest segment.
+class LightModel {
+ public:
+  // f(x) for x = 0 ... 256 (the upper end of the last color value), per channel.
+  struct Map {
+    std::array<std::array<double, 257>, 3> f;
+    double at(int channel, double x) const;
+    Eigen::Vector3d apply(const Eigen::Vector3d& color) const;
+    // The largest slope of the channels' functions over [x - half_width, x + half_width].
+    double maxSlope(const Eigen::Vector3d& x, double half_width) const;
+  };
+
+  // This cycle's anchor colors: carpet, line and chassis samples (any may be empty).
+  void observe(const std::vector<Eigen::Vector3f>& green, const std::vector<Eigen::Vector3f>& white,
+               const std::vector<Eigen::Vector3f>& chassis);
+  bool hasReference() const { return has_reference_; }
+  // The carpet's median color now and in the reference.
+  const Eigen::Vector3d& greenMedian() const { return current_green_median_; }
+  const Eigen::Vector3d& referenceGreenMedian() const { return reference_green_median_; }
+  bool observedGreen() const { return observed_green_; }
+
+  // The map from the reference to this cycle's anchors. False when the anchors do not describe a
+  // global change of light: fewer than two anchors per channel, or slopes further apart (within a
+  // channel between the anchor classes, or between the channels at the carpet) than light,
+  // contrast and gamma make them (a poster laid on the carpet moves green, not white or black).
+  // `space` decides the chroma channels' pivot for a one-anchor fall-back.
+  bool estimate(ColorSpace space, Map* map) const;
+
+  // After a cycle without a change: the reference follows the anchors with memory eta (eq. 4).
+  void follow(double eta);
+  // After a change: the reference becomes this cycle's anchors; anchors not seen are mapped.
+  void rebase(const Map& map);
+  void reset();
+
+ private:
+  // Per anchor class (0 chassis, 1 carpet, 2 lines), quantile levels of each.
+  static constexpr int kAnchorClasses = 3;
+  struct Anchors {
+    std::array<std::vector<Eigen::Vector3d>, kAnchorClasses> quantiles;  // empty: not seen
+  };
+  Anchors current_, reference_;
+  bool has_reference_ = false;
+  bool observed_green_ = false;
+  Eigen::Vector3d current_green_median_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d reference_green_median_ = Eigen::Vector3d::Zero();
+  std::vector<float> scratch_;
+};
+
+}  // namespace core
+}  // namespace act_color

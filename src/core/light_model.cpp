@@ -1,0 +1,203 @@
+#include "act_color/core/light_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace act_color {
+namespace core {
+namespace {
+
+// Quantile levels per anchor class (chassis, carpet, lines) and the samples each needs. A monotone
+// map keeps every channel's quantiles: q(f(X)) = f(q(X)), so matching them recovers f.
+const std::array<std::vector<double>, 3> kLevels = {std::vector<double>{0.25, 0.5, 0.75},
+                                                    std::vector<double>{0.1, 0.3, 0.5, 0.7, 0.9},
+                                                    std::vector<double>{0.25, 0.5, 0.75}};
+constexpr std::array<size_t, 3> kMinSamples = {8, 20, 6};
+constexpr int kGreenAnchor = 1;
+// Slopes of one channel's map between the anchor classes' medians may differ by this factor
+// (gamma 1.6 between chassis, carpet and lines: about 1.6; a carpet turned magenta: 19).
+constexpr double kMaxSlopeSpread = 4.0;
+// The channels' gains at the carpet may differ by this factor (color temperature, white balance).
+constexpr double kMaxGainSpread = 2.5;
+// Anchor medians closer than this (channel units) tell no slope.
+constexpr double kMinAnchorDistance = 8.0;
+constexpr double kMinExtrapolationBase = 24.0;
+
+}  // namespace
+
+double LightModel::Map::at(int channel, double x) const {
+  const double c = std::clamp(x, 0.0, 256.0);
+  const int i = std::min(255, static_cast<int>(c));
+  return f[channel][i] + (c - i) * (f[channel][i + 1] - f[channel][i]);
+}
+
+Eigen::Vector3d LightModel::Map::apply(const Eigen::Vector3d& color) const {
+  return Eigen::Vector3d(at(0, color[0]), at(1, color[1]), at(2, color[2]));
+}
+
+double LightModel::Map::maxSlope(const Eigen::Vector3d& x, double half_width) const {
+  double slope = 0.0;
+  const double h = std::max(half_width, 1.0);
+  for (int c = 0; c < 3; ++c) slope = std::max(slope, (at(c, x[c] + h) - at(c, x[c] - h)) / (2.0 * h));
+  return slope;
+}
+
+void LightModel::observe(const std::vector<Eigen::Vector3f>& green, const std::vector<Eigen::Vector3f>& white,
+                         const std::vector<Eigen::Vector3f>& chassis) {
+  const std::array<const std::vector<Eigen::Vector3f>*, kAnchorClasses> samples = {&chassis, &green, &white};
+  for (int a = 0; a < kAnchorClasses; ++a) {
+    auto& q = current_.quantiles[a];
+    q.clear();
+    const auto& s = *samples[a];
+    if (s.size() < kMinSamples[a]) continue;
+    q.assign(kLevels[a].size(), Eigen::Vector3d::Zero());
+    scratch_.resize(s.size());
+    for (int c = 0; c < 3; ++c) {
+      for (size_t i = 0; i < s.size(); ++i) scratch_[i] = s[i][c];
+      std::sort(scratch_.begin(), scratch_.end());
+      for (size_t l = 0; l < kLevels[a].size(); ++l) {
+        const double pos = kLevels[a][l] * static_cast<double>(s.size() - 1);
+        const size_t lo = static_cast<size_t>(pos);
+        const size_t hi = std::min(s.size() - 1, lo + 1);
+        q[l][c] = scratch_[lo] + (pos - lo) * (scratch_[hi] - scratch_[lo]);
+      }
+    }
+  }
+  observed_green_ = !current_.quantiles[kGreenAnchor].empty();
+  if (observed_green_) current_green_median_ = current_.quantiles[kGreenAnchor][2];
+}
+
+bool LightModel::estimate(ColorSpace space, Map* map) const {
+  if (!has_reference_ || !observed_green_ || reference_.quantiles[kGreenAnchor].empty()) return false;
+  const Eigen::Vector3d pivot = space == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
+  // The channels' gains at the carpet about their zero (0, or 128 for chroma).
+  double gain_min = 1e9, gain_max = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double from = reference_green_median_[c] - pivot[c];
+    if (std::abs(from) < kMinAnchorDistance) continue;
+    const double gain = (current_green_median_[c] - pivot[c]) / from;
+    gain_min = std::min(gain_min, gain);
+    gain_max = std::max(gain_max, gain);
+  }
+  if (gain_max <= 0.0 || gain_min <= 0.0 || gain_max > kMaxGainSpread * gain_min) return false;
+
+  for (int c = 0; c < 3; ++c) {
+    // Anchor points (before, after), and the anchor classes' medians for the slope check.
+    std::vector<std::pair<double, double>> points, medians;
+    for (int a = 0; a < kAnchorClasses; ++a) {
+      const auto& cur = current_.quantiles[a];
+      const auto& ref = reference_.quantiles[a];
+      if (cur.empty() || ref.empty()) continue;
+      for (size_t l = 0; l < cur.size(); ++l) points.emplace_back(ref[l][c], cur[l][c]);
+      const size_t median = cur.size() / 2;
+      medians.emplace_back(ref[median][c], cur[median][c]);
+    }
+    std::sort(medians.begin(), medians.end());
+    double slope_min = 1e9, slope_max = 0.0;
+    for (size_t i = 0; i + 1 < medians.size(); ++i) {
+      const double dx = medians[i + 1].first - medians[i].first;
+      if (dx < kMinAnchorDistance) continue;
+      const double slope = (medians[i + 1].second - medians[i].second) / dx;
+      slope_min = std::min(slope_min, slope);
+      slope_max = std::max(slope_max, slope);
+    }
+    if (slope_max > 0.0 && (slope_min <= 0.0 || slope_max > kMaxSlopeSpread * slope_min)) return false;
+    // Points with (nearly) the same input are one point; then outputs made non-decreasing by
+    // pooling adjacent violators.
+    std::sort(points.begin(), points.end());
+    struct Block {
+      double x, y, n;
+    };
+    std::vector<Block> blocks;
+    for (const auto& [x, y] : points) {
+      if (!blocks.empty() && x - blocks.back().x / blocks.back().n < 1.0) {
+        blocks.back().x += x;
+        blocks.back().y += y;
+        blocks.back().n += 1;
+      } else {
+        blocks.push_back({x, y, 1});
+      }
+      while (blocks.size() >= 2) {
+        Block& b = blocks[blocks.size() - 1];
+        Block& a = blocks[blocks.size() - 2];
+        if (a.y / a.n <= b.y / b.n) break;
+        a.x += b.x;
+        a.y += b.y;
+        a.n += b.n;
+        blocks.pop_back();
+      }
+    }
+    std::vector<std::pair<double, double>> knots;
+    for (const Block& b : blocks) knots.emplace_back(b.x / b.n, b.y / b.n);
+    if (knots.size() < 2) {
+      // One anchor: a gain about the channel's zero through it.
+      const double x = knots.empty() ? reference_green_median_[c] : knots[0].first;
+      const double y = knots.empty() ? current_green_median_[c] : knots[0].second;
+      knots = {{pivot[c], pivot[c]}, {x, y}};
+      if (std::abs(x - pivot[c]) < kMinAnchorDistance) knots = {{0.0, 0.0}, {255.0, 255.0}};
+      std::sort(knots.begin(), knots.end());
+    }
+    // Beyond the outer knots the map continues with the slope over the outermost stretch of at
+    // least kMinExtrapolationBase (the quantiles of one class lie too close for a slope).
+    auto secant = [&](size_t from, int direction) {
+      for (size_t j = from; j < knots.size(); j += direction) {
+        const double dx = knots[j].first - knots[from].first;
+        if (std::abs(dx) >= kMinExtrapolationBase) return (knots[j].second - knots[from].second) / dx;
+        if (j == 0 && direction < 0) break;
+      }
+      const double dx = knots.back().first - knots.front().first;
+      return dx > 0 ? (knots.back().second - knots.front().second) / dx : 1.0;
+    };
+    const double slope_below = secant(0, 1), slope_above = secant(knots.size() - 1, -1);
+    size_t segment = 0;
+    for (int x = 0; x <= 256; ++x) {
+      double y;
+      if (x <= knots.front().first) {
+        y = knots.front().second + slope_below * (x - knots.front().first);
+      } else if (x >= knots.back().first) {
+        y = knots.back().second + slope_above * (x - knots.back().first);
+      } else {
+        while (x > knots[segment + 1].first) ++segment;
+        const auto& [x0, y0] = knots[segment];
+        const auto& [x1, y1] = knots[segment + 1];
+        y = y0 + (y1 - y0) * (x - x0) / (x1 - x0);
+      }
+      map->f[c][x] = std::clamp(y, 0.0, 256.0);
+    }
+  }
+  return true;
+}
+
+void LightModel::follow(double eta) {
+  if (!observed_green_) return;
+  for (int a = 0; a < kAnchorClasses; ++a) {
+    const auto& cur = current_.quantiles[a];
+    auto& ref = reference_.quantiles[a];
+    if (cur.empty()) continue;
+    if (ref.empty() || !has_reference_) {
+      ref = cur;
+      continue;
+    }
+    for (size_t l = 0; l < cur.size(); ++l) ref[l] = (eta * ref[l] + cur[l]) / (eta + 1.0);
+  }
+  reference_green_median_ = reference_.quantiles[kGreenAnchor][2];
+  has_reference_ = true;
+}
+
+void LightModel::rebase(const Map& map) {
+  for (int a = 0; a < kAnchorClasses; ++a) {
+    const auto& cur = current_.quantiles[a];
+    auto& ref = reference_.quantiles[a];
+    if (!cur.empty()) {
+      ref = cur;
+    } else {
+      for (auto& q : ref) q = map.apply(q);
+    }
+  }
+  reference_green_median_ = reference_.quantiles[kGreenAnchor][2];
+}
+
+void LightModel::reset() { *this = LightModel(); }
+
+}  // namespace core
+}  // namespace act_color

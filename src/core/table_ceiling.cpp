@@ -1,0 +1,65 @@
+#include "act_color/core/table_ceiling.hpp"
+
+#include <stdexcept>
+
+namespace act_color {
+namespace core {
+
+TableCeiling::TableCeiling(int bits_per_channel, ColorSpace space)
+    : bits_(bits_per_channel), space_(space), index_(bits_per_channel, space) {
+  counts_.assign(index_.size(), std::array<uint32_t, kNumClasses>{});
+}
+
+void TableCeiling::clear() {
+  std::fill(counts_.begin(), counts_.end(), std::array<uint32_t, kNumClasses>{});
+  pixels_ = 0;
+}
+
+void TableCeiling::add(const ImageView& image, const cv::Mat& truth) {
+  if (truth.type() != CV_8UC1 || truth.cols != image.width || truth.rows != image.height) {
+    throw std::invalid_argument("truth must be a mono8 image of the image's size");
+  }
+  if (nativeColorSpace(image.format) != space_) throw std::invalid_argument("image is not in the table's color space");
+  for (int v = 0; v < image.height; ++v) {
+    const uint8_t* t = truth.ptr<uint8_t>(v);
+    for (int u = 0; u < image.width; ++u) {
+      if (t[u] >= kNumClasses) continue;
+      uint8_t c[3];
+      image.color(u, v, c);
+      ++counts_[index_.index(c[0], c[1], c[2])][t[u]];
+      ++pixels_;
+    }
+  }
+}
+
+ColorLut TableCeiling::table() const {
+  ColorLut lut(bits_, space_);
+  for (uint32_t cell = 0; cell < counts_.size(); ++cell) {
+    const auto& n = counts_[cell];
+    int best = kUnknown;
+    for (int k = 1; k < kNumClasses; ++k) {
+      if (n[k] > n[best]) best = k;
+    }
+    if (best != kUnknown) lut.set(cell, static_cast<uint8_t>(best));
+  }
+  return lut;
+}
+
+ClassificationMetrics TableCeiling::metrics() const {
+  // The confusion of the majority table follows from the counts alone: every pixel of a cell is
+  // classified as the cell's majority class.
+  std::array<std::array<uint64_t, kNumClasses>, kNumClasses> confusion{};
+  for (const auto& n : counts_) {
+    int best = kUnknown;
+    for (int k = 1; k < kNumClasses; ++k) {
+      if (n[k] > n[best]) best = k;
+    }
+    for (int t = 0; t < kNumClasses; ++t) confusion[t][best] += n[t];
+  }
+  ClassificationMetrics m;
+  m.setConfusion(confusion);
+  return m;
+}
+
+}  // namespace core
+}  // namespace act_color
