@@ -6,6 +6,7 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <stdexcept>
 
 namespace act_color {
 namespace sim {
@@ -123,12 +124,12 @@ double slabHit(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::
 }
 
 // What a ray met first.
-enum class Surface : uint8_t { kNone, kFloor, kGoal, kWall, kCeiling, kClutter, kRobot, kBall };
+enum class Surface : uint8_t { kNone, kFloor, kGoal, kWall, kCeiling, kClutter, kRobot, kBall, kPerson };
 
 }  // namespace
 
 struct Renderer::Impl {
-  explicit Impl(const core::Calibration& calibration, uint32_t hall_seed);
+  Impl(const core::Calibration& calibration, const RendererOptions& options);
 
   core::Calibration calibration;
   core::ExpectedClassModel model;
@@ -138,6 +139,12 @@ struct Renderer::Impl {
   std::vector<uint32_t> imaged;
   std::vector<float> vignette_radius2;  // (r / mirror radius)^2 per imaged pixel
   std::vector<uint8_t> imaged_mask;     // per pixel: 1 inside the mirror
+  // Per imaged pixel: index into `struts` + 1 of the strut covering it, 0 for none; and the
+  // pixel's relative offset from the strut's axis in [-1, 1] (for the rod's highlight). Empty
+  // without struts.
+  std::vector<uint8_t> strut_of_pixel;
+  std::vector<float> strut_offset;
+  std::vector<Material> struts;
 
   // Hall: walls at +-hall_x, +-hall_y, ceiling at hall_height.
   double hall_x = 0.0, hall_y = 0.0, hall_height = 4.0;
@@ -155,8 +162,9 @@ struct Renderer::Impl {
   }
 };
 
-Renderer::Impl::Impl(const core::Calibration& cal, uint32_t hall_seed)
-    : calibration(cal), model(cal), texture(hall_seed * 2654435761u + 12345u) {
+Renderer::Impl::Impl(const core::Calibration& cal, const RendererOptions& options)
+    : calibration(cal), model(cal), texture(options.hall_seed * 2654435761u + 12345u) {
+  const uint32_t hall_seed = options.hall_seed;
   const core::OmniCameraModel& camera = model.camera();
   const size_t pixels = camera.rays().size();
   imaged_mask.assign(pixels, 0);
@@ -179,52 +187,70 @@ Renderer::Impl::Impl(const core::Calibration& cal, uint32_t hall_seed)
     m.texture_offset = offset;
     return m;
   };
-  carpet = material(52, 138, 58, 0.22f, 1.f, 0.f);
-  line = material(224, 228, 218, 0.08f, 1.f, 101.f);
-  yellow_goal = material(228, 196, 28, 0.08f, 0.5f, 203.f);
-  blue_goal = material(28, 72, 192, 0.08f, 0.5f, 307.f);
-  robot = material(34, 34, 38, 0.35f, 0.7f, 409.f);
-  ball = material(240, 108, 22, 0.06f, 1.f, 13.f);
-  chassis = material(30, 30, 33, 0.3f, 3.f, 57.f);
-  hall_floor = material(150, 142, 128, 0.3f, 0.25f, 71.f);
-  wall = material(196, 190, 176, 0.15f, 0.2f, 83.f);
-  ceiling = material(110, 110, 116, 0.15f, 0.2f, 97.f);
+  auto look = [&material](const SurfaceLook& l, float scale, float offset) {
+    return material(l.rgb[0], l.rgb[1], l.rgb[2], l.texture_amplitude, scale, offset);
+  };
+  carpet = look(options.carpet, 1.f, 0.f);
+  line = look(options.line, 1.f, 101.f);
+  yellow_goal = look(options.yellow_goal, 0.5f, 203.f);
+  blue_goal = look(options.blue_goal, 0.5f, 307.f);
+  robot = look(options.robot, 0.7f, 409.f);
+  ball = look(options.ball, 1.f, 13.f);
+  chassis = look(options.chassis, 3.f, 57.f);
+  hall_floor = look(options.hall_floor, 0.25f, 71.f);
+  wall = look(options.wall, 0.2f, 83.f);
+  ceiling = look(options.ceiling, 0.2f, 97.f);
+
+  // Struts: which imaged pixels they cover, looked up once instead of per frame.
+  if (options.struts.size() > 254) throw std::invalid_argument("Renderer: at most 254 struts");
+  for (const Strut& strut : options.struts) {
+    struts.push_back(material(strut.rgb[0], strut.rgb[1], strut.rgb[2], 0.12f, 2.f, 29.f));
+  }
+  if (!options.struts.empty()) {
+    strut_of_pixel.assign(imaged.size(), 0);
+    strut_offset.assign(imaged.size(), 0.f);
+    for (size_t n = 0; n < imaged.size(); ++n) {
+      const double du = static_cast<double>(imaged[n] % camera.width()) - cal.camera.center_u;
+      const double dv = static_cast<double>(imaged[n] / camera.width()) - cal.camera.center_v;
+      const double r = std::hypot(du, dv);
+      const double angle = std::atan2(dv, du);
+      for (size_t k = 0; k < options.struts.size(); ++k) {
+        const Strut& strut = options.struts[k];
+        if (r < strut.inner_radius_px || r > strut.outer_radius_px || !(strut.half_width_rad > 0)) continue;
+        const double off = std::remainder(angle - strut.bearing_rad, 2.0 * M_PI);
+        if (std::abs(off) > strut.half_width_rad) continue;
+        strut_of_pixel[n] = static_cast<uint8_t>(k + 1);
+        strut_offset[n] = static_cast<float>(off / strut.half_width_rad);
+        break;
+      }
+    }
+  }
 
   const core::FieldModel& field = model.field();
   const double carpet_x = field.halfLength() + cal.field.margin_m;
   const double carpet_y = field.halfWidth() + cal.field.margin_m;
-  hall_x = carpet_x + 4.0;
-  hall_y = carpet_y + 4.0;
+  const double hall_distance = options.hall_wall_distance_m;
+  // Narrower bands leave no room for the boxes' 0.6 m from the carpet and 0.2 m from the wall.
+  if (!(hall_distance >= 1.2)) throw std::invalid_argument("Renderer: hall_wall_distance_m must be at least 1.2 m");
+  if (options.clutter_palette.empty()) throw std::invalid_argument("Renderer: empty clutter palette");
+  hall_x = carpet_x + hall_distance;
+  hall_y = carpet_y + hall_distance;
+  hall_height = options.hall_height_m;
 
-  // Clutter colors, several of them close to class colors.
-  static const double kClutter[][3] = {
-      {70, 140, 76},    // greenish
-      {112, 132, 60},   // olive
-      {214, 190, 72},   // yellowish
-      {200, 178, 138},  // beige
-      {62, 92, 172},    // bluish
-      {40, 50, 92},     // navy
-      {226, 226, 214},  // whitish
-      {178, 178, 172},  // light grey
-      {40, 38, 42},     // dark
-      {112, 76, 50},    // brown
-      {172, 52, 46},    // red
-      {112, 62, 132},   // purple
-      {204, 116, 64},   // orange-brown
-      {90, 160, 150},   // teal
-  };
-  constexpr int kNumClutter = sizeof(kClutter) / sizeof(kClutter[0]);
+  const std::vector<Eigen::Vector3d>& palette = options.clutter_palette;
+  const int num_clutter = static_cast<int>(palette.size());
   std::mt19937 rng(hall_seed);
   auto uniform = [&rng](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
   auto clutterMaterial = [&](float amplitude) {
-    const int c = std::uniform_int_distribution<int>(0, kNumClutter - 1)(rng);
-    return material(kClutter[c][0], kClutter[c][1], kClutter[c][2], amplitude, 0.5f,
-                    static_cast<float>(uniform(0, 500)));
+    const int c = std::uniform_int_distribution<int>(0, num_clutter - 1)(rng);
+    return material(palette[c][0], palette[c][1], palette[c][2], amplitude, 0.5f, static_cast<float>(uniform(0, 500)));
   };
 
-  // Boxes standing in the band between the carpet and the walls.
-  for (int n = 0; n < 14; ++n) {
-    const double sx = uniform(0.3, 1.4), sy = uniform(0.3, 1.4), sz = uniform(0.3, 2.0);
+  // Boxes standing in the band between the carpet and the walls: at least 0.6 m from the carpet
+  // and 0.2 m from the wall, so a narrow band takes smaller boxes (1.4 m in the default 4 m band).
+  const double max_box_m = std::max(0.3, std::min(1.4, hall_distance - 0.8));
+  for (int n = 0; n < options.num_boxes; ++n) {
+    const double sx = uniform(0.3, max_box_m), sy = uniform(0.3, max_box_m), sz = uniform(0.3, 2.0);
     double cx, cy;
     const int side = std::uniform_int_distribution<int>(0, 3)(rng);
     if (side < 2) {
@@ -243,7 +269,7 @@ Renderer::Impl::Impl(const core::Calibration& cal, uint32_t hall_seed)
   // Posters, doors and windows on the walls.
   for (int w = 0; w < 4; ++w) {
     const double half = w < 2 ? hall_y : hall_x;
-    for (int n = 0; n < 9; ++n) {
+    for (int n = 0; n < options.num_wall_patches; ++n) {
       Patch p;
       const double width = uniform(0.8, 3.5);
       const double s = uniform(-half, half - width);
@@ -261,7 +287,7 @@ Renderer::Impl::Impl(const core::Calibration& cal, uint32_t hall_seed)
     }
   }
   // Mats and markings on the hall floor.
-  for (int n = 0; n < 10; ++n) {
+  for (int n = 0; n < options.num_floor_mats; ++n) {
     Patch p;
     const double sx = uniform(0.5, 2.5), sy = uniform(0.5, 2.5);
     double cx = uniform(-hall_x, hall_x), cy = uniform(-hall_y, hall_y);
@@ -290,8 +316,39 @@ Renderer::Impl::Impl(const core::Calibration& cal, uint32_t hall_seed)
   }
 }
 
+namespace {
+RendererOptions withHallSeed(uint32_t hall_seed) {
+  RendererOptions options;
+  options.hall_seed = hall_seed;
+  return options;
+}
+}  // namespace
+
+const std::vector<Eigen::Vector3d>& defaultClutterPalette() {
+  static const std::vector<Eigen::Vector3d> kPalette = {
+      {70, 140, 76},    // greenish
+      {112, 132, 60},   // olive
+      {214, 190, 72},   // yellowish
+      {200, 178, 138},  // beige
+      {62, 92, 172},    // bluish
+      {40, 50, 92},     // navy
+      {226, 226, 214},  // whitish
+      {178, 178, 172},  // light grey
+      {40, 38, 42},     // dark
+      {112, 76, 50},    // brown
+      {172, 52, 46},    // red
+      {112, 62, 132},   // purple
+      {204, 116, 64},   // orange-brown
+      {90, 160, 150},   // teal
+  };
+  return kPalette;
+}
+
 Renderer::Renderer(const core::Calibration& calibration, uint32_t hall_seed)
-    : impl_(std::make_shared<const Impl>(calibration, hall_seed)) {}
+    : Renderer(calibration, withHallSeed(hall_seed)) {}
+
+Renderer::Renderer(const core::Calibration& calibration, const RendererOptions& options)
+    : impl_(std::make_shared<const Impl>(calibration, options)) {}
 
 const core::ExpectedClassModel& Renderer::model() const { return impl_->model; }
 
@@ -330,7 +387,9 @@ LabeledFrame Renderer::render(const Scene& scene) const {
 
   const core::PoseTransform pose(scene.robot_pose);
   const Eigen::Vector3d origin(pose.x_m, pose.y_m, cam_h);
-  const Eigen::Vector3f gains = temperatureGains(light.color_temperature_k);
+  // Light color times the camera's white balance: both are per-channel gains on the linear signal.
+  const Eigen::Vector3f gains =
+      temperatureGains(light.color_temperature_k).cwiseProduct(light.white_balance.cast<float>());
   const float exposure = static_cast<float>(light.exposure);
 
   // Exposure-scaled linear light -> 8 bit through gamma: a table instead of pow per channel.
@@ -362,6 +421,9 @@ LabeledFrame Renderer::render(const Scene& scene) const {
   const double carpet_y = field.halfWidth() + im.calibration.field.margin_m;
   const bool robot_on_carpet = std::abs(pose.x_m) < carpet_x && std::abs(pose.y_m) < carpet_y;
   const float chassis_light = lightAt(pose.x_m, pose.y_m, false);
+  const bool has_struts = !im.strut_of_pixel.empty();
+  const bool saturate = light.saturation != 1.0;
+  const float saturation = static_cast<float>(light.saturation);
 
   for (size_t n = 0; n < im.imaged.size(); ++n) {
     const size_t i = im.imaged[n];
@@ -370,7 +432,15 @@ LabeledFrame Renderer::render(const Scene& scene) const {
     uint8_t label = core::kUnknown;
     float illumination = 1.f;
 
-    if (ray.region == core::PixelRegion::kChassis) {
+    if (has_struts && im.strut_of_pixel[n] != 0) {
+      // A strut in front of the mirror: a metal rod, brightest along its axis.
+      const Material& m = im.struts[im.strut_of_pixel[n] - 1];
+      const float off = im.strut_offset[n];
+      const double rr = std::sqrt(static_cast<double>(im.vignette_radius2[n])) * im.calibration.camera.mirror_radius_px;
+      color = m.albedo * ((0.55f + 0.6f * (1.f - off * off)) * im.textured(m, rr * 0.01, off * 0.05));
+      label = core::kBlack;
+      illumination = chassis_light * 0.8f;
+    } else if (ray.region == core::PixelRegion::kChassis) {
       const double a = ray.bearing_rad;
       const double rr = std::hypot(static_cast<double>(i % width) - im.calibration.camera.center_u,
                                    static_cast<double>(i / width) - im.calibration.camera.center_v);
@@ -418,9 +488,10 @@ LabeledFrame Renderer::render(const Scene& scene) const {
         surface = t_hit == tz ? Surface::kCeiling : Surface::kWall;
       }
 
-      // Clutter boxes can only be met by rays that leave the carpet.
+      // Clutter boxes and people can only be met by rays that leave the carpet.
       int box_index = -1, box_axis = 2;
-      if (!robot_on_carpet || !im.model.surelyOnCarpet(i, safe_range)) {
+      const bool may_leave_carpet = !robot_on_carpet || !im.model.surelyOnCarpet(i, safe_range);
+      if (may_leave_carpet) {
         for (size_t b = 0; b < im.boxes.size(); ++b) {
           int axis = 2;
           const double t = slabHit(origin, dir, im.boxes[b].min_corner, im.boxes[b].max_corner, t_hit, &axis);
@@ -469,8 +540,46 @@ LabeledFrame Renderer::render(const Scene& scene) const {
           }
         }
       }
+      // People: vertical cylinders (their tops are above the camera in practice; a ray from above
+      // meets the head's top disc).
+      int person_index = -1;
+      bool person_top = false;
+      if (may_leave_carpet) {
+        for (size_t k = 0; k < scene.people.size(); ++k) {
+          const Person& pe = scene.people[k];
+          const double ox = origin.x() - pe.x_m, oy = origin.y() - pe.y_m;
+          const double b = ox * dir.x() + oy * dir.y();
+          const double c = ox * ox + oy * oy - pe.radius_m * pe.radius_m;
+          if (b >= 0 && c > 0) continue;
+          const double disc = b * b - a2 * c;
+          if (disc < 0 || a2 <= 0) continue;
+          const double t_side = (-b - std::sqrt(disc)) / a2;
+          if (t_side > 0 && t_side < t_hit) {
+            const double z = origin.z() + t_side * dir.z();
+            if (z >= 0 && z <= pe.height_m) {
+              t_hit = t_side;
+              person_index = static_cast<int>(k);
+              person_top = false;
+              surface = Surface::kPerson;
+              continue;
+            }
+          }
+          if (dir.z() < 0 && origin.z() > pe.height_m) {
+            const double t_top = (pe.height_m - origin.z()) / dir.z();
+            if (t_top < t_hit) {
+              const double px = ox + t_top * dir.x(), py = oy + t_top * dir.y();
+              if (px * px + py * py <= pe.radius_m * pe.radius_m) {
+                t_hit = t_top;
+                person_index = static_cast<int>(k);
+                person_top = true;
+                surface = Surface::kPerson;
+              }
+            }
+          }
+        }
+      }
       // The ball.
-      Eigen::Vector3d ball_center;
+      Eigen::Vector3d ball_center = Eigen::Vector3d::Zero();
       if (scene.ball) {
         ball_center = Eigen::Vector3d(scene.ball->x_m, scene.ball->y_m, scene.ball->radius_m);
         const Eigen::Vector3d oc = origin - ball_center;
@@ -578,6 +687,24 @@ LabeledFrame Renderer::render(const Scene& scene) const {
           illumination = lightAt(p.x(), p.y(), false);
           break;
         }
+        case Surface::kPerson: {
+          label = core::kUnknown;
+          const Person& pe = scene.people[person_index];
+          const double rel = p.z() / pe.height_m;
+          const Eigen::Vector3d& rgb = person_top || rel > 0.87 ? pe.skin_rgb
+                                       : rel > 0.48             ? pe.shirt_rgb
+                                                                : pe.trousers_rgb;
+          const Eigen::Vector3f albedo = linearFromSrgb(rgb[0], rgb[1], rgb[2]);
+          float shade = 1.0f;
+          if (!person_top) {
+            const double nx = (p.x() - pe.x_m) / pe.radius_m, ny = (p.y() - pe.y_m) / pe.radius_m;
+            shade = static_cast<float>(0.65 + 0.2 * nx + 0.05 * ny);
+          }
+          const double angle = std::atan2(p.y() - pe.y_m, p.x() - pe.x_m);
+          color = albedo * (shade * im.textured(im.wall, angle * pe.radius_m + 5.0 * person_index, p.z()));
+          illumination = lightAt(p.x(), p.y(), false);
+          break;
+        }
         case Surface::kBall: {
           label = core::kOrange;
           const Eigen::Vector3d normal = (p - ball_center) / scene.ball->radius_m;
@@ -600,6 +727,13 @@ LabeledFrame Renderer::render(const Scene& scene) const {
       const float v = std::max(0.f, color[c] * gains[c] * scale);
       out[c] = gamma_table[v >= kGammaBins ? kGammaBins : static_cast<int>(v)];
     }
+    if (saturate) {
+      // The camera's color matrix: more or less color about the same grey (Rec. 601 luma).
+      const float grey = 0.299f * out[0] + 0.587f * out[1] + 0.114f * out[2];
+      for (int c = 0; c < 3; ++c) {
+        out[c] = static_cast<uint8_t>(std::clamp(grey + saturation * (out[c] - grey) + 0.5f, 0.f, 255.f));
+      }
+    }
     labels[i] = label;
   }
 
@@ -613,7 +747,10 @@ LabeledFrame Renderer::render(const Scene& scene) const {
     rng.fill(noise, cv::RNG::NORMAL, 0.0, light.noise_sigma);
   }
   const float f = static_cast<float>(light.brightness_contrast);
+  const float black = static_cast<float>(light.black_level);
   const float* noise_data = noise.empty() ? nullptr : noise.ptr<float>(0);
+  const bool transfer = !light.transfer.isIdentity();
+  const auto& tables = light.transfer.tables();
   const size_t pixels = static_cast<size_t>(width) * height;
   for (size_t i = 0; i < pixels; ++i) {
     uint8_t* out = rgb + 3 * i;
@@ -622,8 +759,11 @@ LabeledFrame Renderer::render(const Scene& scene) const {
       continue;
     }
     for (int c = 0; c < 3; ++c) {
-      const float v = f * (out[c] + (noise_data ? noise_data[3 * i + c] : 0.f)) + 0.5f;
+      const float v = f * (out[c] + (noise_data ? noise_data[3 * i + c] : 0.f) + black) + 0.5f;
       out[c] = static_cast<uint8_t>(std::clamp(v, 0.f, 255.f));
+    }
+    if (transfer) {
+      for (int c = 0; c < 3; ++c) out[c] = tables[c][out[c]];
     }
   }
   return frame;

@@ -3,6 +3,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "act_color/core/calibration.hpp"
 #include "act_color/sim/renderer.hpp"
@@ -28,6 +29,20 @@ struct FamilyScene {
 };
 
 FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length = ScenarioLength::kSmall);
+
+// The kinds of the family's events (ScenarioFrame::events), in a fixed order. The first five are
+// the named sudden changes (tone curves from the event's frame on): "darken" (the paper's
+// brightness and contrast to 50%, ToneCurve::brightnessContrast(0.5, 0.5)), "gain_0.5",
+// "gamma_1.6", "warm_white_balance" (ToneCurve::whiteBalance(-2000)), "brighten" (gain 1.5-1.6).
+// Then "tone" (events "tone:<description>", a ToneCurve::random), "slow_change" (light level
+// ramp over ~30 frames, 90 in kFull), "auto_exposure" (exposure swinging 0.7-1.3, then settling),
+// "wrong_pose" (told pose 2.5 m off and rotated 165 degrees for some frames, paper 3.3) and
+// "drive" (a static robot starts driving; told poses get a few cm of noise).
+const std::vector<std::string>& familyEventKinds();
+// The kind of an event name: the text before ':' ("tone:gain0.62" -> "tone").
+std::string familyEventKind(const std::string& event);
+// True for the five named sudden changes.
+bool isNamedToneChange(const std::string& event);
 
 // The fixed split of issue 11: tune on [0, 100), report on [1000, 1100).
 constexpr uint32_t kTuningSeedsBegin = 0, kTuningSeedsEnd = 100;
