@@ -25,6 +25,13 @@ constexpr double kIntensityWeight = 0.1;
 // A cell confirmed again within this many cycles does not fill its neighbourhood again.
 constexpr uint32_t kNeighbourhoodRefreshCycles = 8;
 
+// Chassis pixels the light model reads every cycle.
+constexpr size_t kChassisAnchorSamples = 192;
+// The light model triggers when the carpet's median moves beyond this many of green's sigmas, or
+// kLightChangeMinShift channel units, whichever is larger.
+constexpr double kLightChangeSigmas = 1.0;
+constexpr double kLightChangeMinShift = 8.0;
+
 // Pixels the cluster and addition steps fetch ahead of the one they look at.
 constexpr int kSamplesAhead = 16;
 
@@ -117,6 +124,14 @@ ActParams ActParams::paper() {
 ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
     : model_(calibration), params_(params), lut_(params.lut_bits), rng_(params.seed) {
   params_.validate();
+  // The chassis is small in the image (a few dozen of the cluster step's samples at most): the
+  // light model reads it densely, every n-th of its pixels.
+  std::vector<uint32_t> chassis;
+  for (size_t i = 0; i < model_.pixels(); ++i) {
+    if (model_.camera().ray(i).region == PixelRegion::kChassis) chassis.push_back(static_cast<uint32_t>(i));
+  }
+  const size_t step = std::max<size_t>(1, chassis.size() / kChassisAnchorSamples);
+  for (size_t j = step / 2; j < chassis.size(); j += step) chassis_pixels_.push_back(chassis[j]);
   reset(ColorSpace::kRgb);
   space_known_ = false;
 }
@@ -456,9 +471,14 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     uint8_t c[3];
     image.color(p.u, p.v, c);
     samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
-    if (expected_k == kBlack) chassis_samples_.emplace_back(c[0], c[1], c[2]);
   });
-  // The anchors of the light model, before any class filters its colors.
+  // The anchors of the light model (before any class filters its colors): carpet and lines from
+  // the cluster samples, the chassis densely.
+  for (const uint32_t i : chassis_pixels_) {
+    uint8_t c[3];
+    image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
+    chassis_samples_.emplace_back(c[0], c[1], c[2]);
+  }
   light_.observe(samples_[kGreen], samples_[kWhite], chassis_samples_);
   const ClusterParams cluster_params = clusterParams();
   if (params_.robust_clusters) {
@@ -479,9 +499,27 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
   const ClassCluster& green = clusters_[kGreen];
   LightModel::Map light_map;
-  if (params_.light_compensation && green.trained() && light_.hasReference() && light_.observedGreen() &&
-      (light_.greenMedian() - light_.referenceGreenMedian()).norm() > params_.zeta * green.sigma() &&
-      light_.estimate(lut_.colorSpace(), &light_map)) {
+  auto lightMoved = [&] {
+    return (light_.greenMedian() - light_.referenceGreenMedian()).norm() >
+           std::max(kLightChangeSigmas * green.sigma(), kLightChangeMinShift);
+  };
+  bool light_changed =
+      params_.light_compensation && green.trained() && light_.hasReference() && light_.observedGreen() && lightMoved();
+  if (light_changed) {
+    // A closer look before the whole table moves: carpet and lines of this frame at the stride of
+    // the change cycle's additions.
+    for (auto& a : anchor_samples_) a.clear();
+    everyNth(std::min(params_.cluster_stride, params_.light_change_add_stride), [&](const StridedPixels& p) {
+      const uint8_t k = expected(p);
+      if (k != kGreen && k != kWhite) return;
+      uint8_t c[3];
+      image.color(p.u, p.v, c);
+      anchor_samples_[k].emplace_back(c[0], c[1], c[2]);
+    });
+    light_.observe(anchor_samples_[kGreen], anchor_samples_[kWhite], chassis_samples_);
+    light_changed = light_.observedGreen() && lightMoved() && light_.estimate(lut_.colorSpace(), &light_map);
+  }
+  if (light_changed) {
     const Eigen::Vector3d from = light_.referenceGreenMedian();
     const Eigen::Vector3d pivot =
         lut_.colorSpace() == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();

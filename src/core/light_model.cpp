@@ -22,6 +22,8 @@ constexpr double kMaxGainSpread = 2.5;
 // Anchor medians closer than this (channel units) tell no slope.
 constexpr double kMinAnchorDistance = 8.0;
 constexpr double kMinExtrapolationBase = 24.0;
+// Quantiles this close to 0 or 255 are clipped.
+constexpr double kClipMargin = 1.5;
 
 }  // namespace
 
@@ -84,13 +86,25 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
   for (int c = 0; c < 3; ++c) {
     // Anchor points (before, after), and the anchor classes' medians for the slope check.
     std::vector<std::pair<double, double>> points, medians;
+    int classes = 0;
     for (int a = 0; a < kAnchorClasses; ++a) {
       const auto& cur = current_.quantiles[a];
       const auto& ref = reference_.quantiles[a];
       if (cur.empty() || ref.empty()) continue;
-      for (size_t l = 0; l < cur.size(); ++l) points.emplace_back(ref[l][c], cur[l][c]);
+      // A clipped value only bounds where the color went.
+      auto clipped = [](double v) { return v <= kClipMargin || v >= 255.0 - kClipMargin; };
+      const size_t before = points.size();
+      for (size_t l = 0; l < cur.size(); ++l) {
+        if (!clipped(cur[l][c]) && !clipped(ref[l][c])) points.emplace_back(ref[l][c], cur[l][c]);
+      }
+      if (points.size() == before) continue;
+      ++classes;
       const size_t median = cur.size() / 2;
-      medians.emplace_back(ref[median][c], cur[median][c]);
+      if (!clipped(cur[median][c]) && !clipped(ref[median][c])) medians.emplace_back(ref[median][c], cur[median][c]);
+    }
+    // One anchor class alone spans too little of the channel: a gain about the channel's zero.
+    if (classes < 2 && !points.empty() && std::abs(reference_green_median_[c] - pivot[c]) >= kMinAnchorDistance) {
+      points.emplace_back(pivot[c], pivot[c]);
     }
     std::sort(medians.begin(), medians.end());
     double slope_min = 1e9, slope_max = 0.0;

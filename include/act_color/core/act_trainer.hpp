@@ -185,6 +185,8 @@ class ActTrainer {
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
   std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
+  std::array<std::vector<Eigen::Vector3f>, kNumClasses> anchor_samples_;  // scratch of a denser look
+  std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, at most ~256
   LightModel light_;
   std::vector<uint8_t> warped_;
   // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.

@@ -25,7 +25,8 @@ class LightModel {
     double maxSlope(const Eigen::Vector3d& x, double half_width) const;
   };
 
-  // This cycle's anchor colors: carpet, line and chassis samples (any may be empty).
+  // This cycle's anchor colors: carpet, line and chassis samples (any may be empty); replaces
+  // what was observed before in this cycle.
   void observe(const std::vector<Eigen::Vector3f>& green, const std::vector<Eigen::Vector3f>& white,
                const std::vector<Eigen::Vector3f>& chassis);
   bool hasReference() const { return has_reference_; }

@@ -1,0 +1,315 @@
+#include "act_color/sim/family_evaluation.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "act_color/core/segmenter.hpp"
+#include "act_color/core/table_ceiling.hpp"
+#include "act_color/sim/renderer.hpp"
+
+namespace act_color {
+namespace sim {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+// input | each mode's labels | truth, in the palette, as BGR for imwrite.
+void writePanel(const std::string& path, const cv::Mat& rgb, const std::vector<cv::Mat>& labels, const cv::Mat& truth) {
+  std::vector<cv::Mat> panels{rgb.clone()};
+  for (const cv::Mat& l : labels) {
+    cv::Mat colored;
+    core::colorizeLabels(l, colored);
+    panels.push_back(colored);
+  }
+  cv::Mat colored_truth;
+  core::colorizeLabels(truth, colored_truth);
+  panels.push_back(colored_truth);
+  cv::Mat row;
+  cv::hconcat(panels, row);
+  cv::cvtColor(row, row, cv::COLOR_RGB2BGR);
+  cv::imwrite(path, row);
+}
+
+// Segments that start with a sudden change of light (settle cycles are measured after those; a
+// slow ramp, an exposure swing, a wrong pose or driving change what the frames show all along).
+bool startsWithSuddenChange(const std::string& event) {
+  size_t begin = 0;
+  while (begin <= event.size()) {
+    const size_t end = std::min(event.find('+', begin), event.size());
+    const std::string part = event.substr(begin, end - begin);
+    if (isNamedToneChange(part) || familyEventKind(part) == "tone") return true;
+    begin = end + 1;
+  }
+  return false;
+}
+
+double f1(double recall, double precision) {
+  if (std::isnan(recall)) return std::nan("");
+  if (std::isnan(precision) || recall + precision <= 0) return 0.0;
+  return 2 * recall * precision / (recall + precision);
+}
+
+Distribution distribution(std::vector<double> values, bool higher_is_better) {
+  Distribution d;
+  d.count = values.size();
+  if (values.empty()) return d;
+  std::sort(values.begin(), values.end());
+  if (!higher_is_better) std::reverse(values.begin(), values.end());
+  // values[0] is now the worst.
+  auto quantile = [&](double q) {
+    const double pos = q * static_cast<double>(values.size() - 1);
+    const size_t lo = static_cast<size_t>(std::floor(pos));
+    const size_t hi = std::min(values.size() - 1, lo + 1);
+    return values[lo] + (pos - lo) * (values[hi] - values[lo]);
+  };
+  d.worst = values.front();
+  d.p10 = quantile(0.1);
+  d.median = quantile(0.5);
+  return d;
+}
+
+}  // namespace
+
+std::vector<EvalMode> evalModes(bool ablations) {
+  std::vector<EvalMode> modes = {{"defaults", core::ActParams()}, {"paper", core::ActParams::paper()}};
+  if (!ablations) return modes;
+  const std::vector<std::pair<std::string, std::function<void(core::ActParams&)>>> off = {
+      {"seed_clusters", [](core::ActParams& p) { p.seed_clusters = false; }},
+      {"add_neighbourhood_cells", [](core::ActParams& p) { p.add_neighbourhood_cells = 0; }},
+      {"robust_clusters", [](core::ActParams& p) { p.robust_clusters = false; }},
+      {"light_compensation", [](core::ActParams& p) { p.light_compensation = false; }},
+      {"removal_protect_cycles", [](core::ActParams& p) { p.removal_protect_cycles = 0; }},
+      {"robots_train_black", [](core::ActParams& p) { p.robots_train_black = false; }},
+      {"nearest_mean", [](core::ActParams& p) { p.nearest_mean = false; }},
+      {"evidence_removal_ratio", [](core::ActParams& p) { p.evidence_removal_ratio = 0; }},
+  };
+  for (const auto& [name, apply] : off) {
+    EvalMode m{"no_" + name, core::ActParams()};
+    apply(m.params);
+    modes.push_back(m);
+  }
+  return modes;
+}
+
+SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>& modes, const EvalOptions& options) {
+  SceneResult result;
+  result.seed = scene.seed;
+  result.summary = scene.summary;
+  const Renderer renderer(scene.calibration, scene.renderer);
+  const core::Segmenter segmenter(scene.calibration.camera);
+  std::vector<core::ActTrainer> trainers;
+  std::vector<core::RunEvaluation> evaluations;
+  std::vector<cv::Mat> labels(modes.size());
+  for (const EvalMode& m : modes) {
+    result.mode_names.push_back(m.name);
+    trainers.emplace_back(scene.calibration, m.params);
+    evaluations.emplace_back(options.adapt_frames);
+  }
+  core::TableCeiling ceiling;
+  size_t segment_start = 0;
+  const auto& frames = scene.scenario.frames;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const ScenarioFrame& f = frames[i];
+    if (!f.events.empty() && i > 0) {
+      result.ceiling.push_back(ceiling.metrics());
+      ceiling.clear();
+      segment_start = i;
+    }
+    const auto t0 = Clock::now();
+    const LabeledFrame frame = renderer.render(f.scene);
+    const auto t1 = Clock::now();
+    const core::ImageView view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
+    for (size_t m = 0; m < modes.size(); ++m) {
+      for (const std::string& e : f.events) evaluations[m].markEvent(e);
+      if (i == 0) trainers[m].bootstrap(view, f.told_pose, std::max(0, options.bootstrap_cycles - 1));
+      trainers[m].cycle(view, f.told_pose);
+      segmenter.classify(trainers[m].lut(), view, labels[m]);
+      evaluations[m].addFrame(labels[m], frame.labels);
+    }
+    const auto t2 = Clock::now();
+    if (i - segment_start >= options.adapt_frames) ceiling.add(view, frame.labels);
+    result.render_seconds += seconds(t1 - t0);
+    result.act_seconds += seconds(t2 - t1);
+    const bool segment_ends = i + 1 == frames.size() || !frames[i + 1].events.empty();
+    if (!options.png_dir.empty() && segment_ends) {
+      char name[96];
+      std::snprintf(name, sizeof(name), "/scene_%05u_frame_%03zu.png", scene.seed, i);
+      writePanel(options.png_dir + name, frame.rgb, labels, frame.labels);
+    }
+  }
+  result.ceiling.push_back(ceiling.metrics());
+  result.frames = frames.size();
+  result.adapt_frames = options.adapt_frames;
+  for (const core::RunEvaluation& e : evaluations) result.segments.push_back(e.segments());
+  return result;
+}
+
+FamilyReport summarize(const std::vector<SceneResult>& results) {
+  FamilyReport r;
+  if (results.empty()) return r;
+  r.mode_names = results.front().mode_names;
+  const size_t modes = r.mode_names.size();
+  const size_t with_ceiling = modes + 1;
+  using Values = std::array<std::vector<double>, core::kNumClasses>;
+  std::vector<Values> recall(with_ceiling), precision(with_ceiling), recall_gap(modes), precision_gap(modes),
+      settle(modes);
+  r.f1_below_paper.assign(modes, {});
+  r.f1_worst_vs_paper.assign(modes, {});
+  r.worst_recall_seed.assign(modes, {});
+  r.worst_precision_seed.assign(modes, {});
+  std::vector<std::array<double, core::kNumClasses>> worst_recall(modes), worst_precision(modes);
+  for (auto& w : worst_recall) w.fill(2.0);
+  for (auto& w : worst_precision) w.fill(2.0);
+  const size_t paper =
+      static_cast<size_t>(std::find(r.mode_names.begin(), r.mode_names.end(), "paper") - r.mode_names.begin());
+  for (const SceneResult& s : results) {
+    for (size_t seg = 0; seg < s.ceiling.size(); ++seg) {
+      const core::ClassificationMetrics& ceil = s.ceiling[seg];
+      const core::SegmentSummary& reference = s.segments[0][seg];
+      const double frames_after =
+          std::max(1.0, static_cast<double>(reference.frames) - static_cast<double>(s.adapt_frames));
+      for (int k : core::trainableClasses()) {
+        if (ceil.truthCount(k) < kMinTruthPixelsPerFrame * frames_after) continue;
+        const double ceil_recall = ceil.recall(k), ceil_precision = ceil.precision(k);
+        recall[modes][k].push_back(ceil_recall);
+        if (!std::isnan(ceil_precision)) precision[modes][k].push_back(ceil_precision);
+        for (size_t m = 0; m < modes; ++m) {
+          const core::SegmentSummary& ss = s.segments[m][seg];
+          const double rec = ss.adapted.recall(k), prec = ss.adapted.precision(k);
+          recall[m][k].push_back(rec);
+          recall_gap[m][k].push_back(ceil_recall - rec);
+          if (rec < worst_recall[m][k]) {
+            worst_recall[m][k] = rec;
+            r.worst_recall_seed[m][k] = s.seed;
+          }
+          const double p = std::isnan(prec) ? 0.0 : prec;
+          precision[m][k].push_back(p);
+          if (!std::isnan(ceil_precision)) precision_gap[m][k].push_back(ceil_precision - p);
+          if (p < worst_precision[m][k]) {
+            worst_precision[m][k] = p;
+            r.worst_precision_seed[m][k] = s.seed;
+          }
+          if (paper < modes) {
+            const core::SegmentSummary& ps = s.segments[paper][seg];
+            const double diff = f1(rec, prec) - f1(ps.adapted.recall(k), ps.adapted.precision(k));
+            if (diff < -0.02) ++r.f1_below_paper[m][k];
+            r.f1_worst_vs_paper[m][k] = std::min(r.f1_worst_vs_paper[m][k], diff);
+          }
+          if (ss.first_frame > 0 && startsWithSuddenChange(ss.event) && !std::isnan(ss.final_recall[k])) {
+            settle[m][k].push_back(ss.settle_cycles[k] < 0 ? static_cast<double>(ss.frames) : ss.settle_cycles[k]);
+          }
+        }
+      }
+    }
+  }
+  auto fill = [](const std::vector<Values>& v, bool higher_is_better) {
+    std::vector<std::array<Distribution, core::kNumClasses>> out(v.size());
+    for (size_t m = 0; m < v.size(); ++m) {
+      for (int k = 0; k < core::kNumClasses; ++k) out[m][k] = distribution(v[m][k], higher_is_better);
+    }
+    return out;
+  };
+  r.recall = fill(recall, true);
+  r.precision = fill(precision, true);
+  r.recall_gap = fill(recall_gap, false);
+  r.precision_gap = fill(precision_gap, false);
+  r.settle = fill(settle, false);
+  return r;
+}
+
+std::string formatReport(const FamilyReport& r) {
+  std::string out;
+  char line[512];
+  if (r.mode_names.empty()) return "no scenes\n";
+  const size_t modes = r.mode_names.size();
+  auto dist = [](const Distribution& d, int precision = 2) {
+    char b[64];
+    if (d.count == 0) return std::string("      -       ");
+    std::snprintf(b, sizeof(b), "%.*f %.*f %.*f", precision, d.median, precision, d.p10, precision, d.worst);
+    return std::string(b);
+  };
+  auto table = [&](const char* title, const std::vector<std::array<Distribution, core::kNumClasses>>& d,
+                   bool with_ceiling, const char* columns) {
+    std::snprintf(line, sizeof(line), "%s (%s; units: scene segments after adaptation)\n", title, columns);
+    out += line;
+    std::snprintf(line, sizeof(line), "  %-7s %5s", "class", "units");
+    out += line;
+    const size_t n = with_ceiling ? modes + 1 : modes;
+    for (size_t m = 0; m < n; ++m) {
+      std::snprintf(line, sizeof(line), " | %-14s", m < modes ? r.mode_names[m].c_str() : "ceiling");
+      out += line;
+    }
+    out += "\n";
+    for (int k : core::trainableClasses()) {
+      std::snprintf(line, sizeof(line), "  %-7s %5zu", core::className(k), d[0][k].count);
+      out += line;
+      for (size_t m = 0; m < n; ++m) out += " | " + dist(d[m][k]);
+      out += "\n";
+    }
+  };
+  table("recall", r.recall, true, "median p10 worst");
+  table("precision", r.precision, true, "median p10 worst");
+  table("recall gap to the ceiling", r.recall_gap, false, "median p90 worst; ceiling - mode");
+  table("precision gap to the ceiling", r.precision_gap, false, "median p90 worst; ceiling - mode");
+  table("cycles to settle after a sudden change of light", r.settle, false,
+        "median p90 worst; within 0.02 of the final recall; never settled = segment length");
+  out += "F1 below the paper's F1 - 0.02 (units; worst F1 difference)\n";
+  for (size_t m = 0; m < modes; ++m) {
+    std::snprintf(line, sizeof(line), "  %-26s", r.mode_names[m].c_str());
+    out += line;
+    for (int k : core::trainableClasses()) {
+      std::snprintf(line, sizeof(line), " %s %zu (%+.2f)", core::className(k), r.f1_below_paper[m][k],
+                    r.f1_worst_vs_paper[m][k]);
+      out += line;
+    }
+    out += "\n";
+  }
+  out += "worst recall / precision at seed\n";
+  for (size_t m = 0; m < modes; ++m) {
+    std::snprintf(line, sizeof(line), "  %-26s", r.mode_names[m].c_str());
+    out += line;
+    for (int k : core::trainableClasses()) {
+      std::snprintf(line, sizeof(line), " %s %u/%u", core::className(k), r.worst_recall_seed[m][k],
+                    r.worst_precision_seed[m][k]);
+      out += line;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::string formatScene(const SceneResult& s) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof(line), "seed %u (%zu frames, render %.1f s, ACT %.1f s): %s\n", s.seed, s.frames,
+                s.render_seconds, s.act_seconds, s.summary.c_str());
+  out += line;
+  for (size_t seg = 0; seg < s.ceiling.size(); ++seg) {
+    std::snprintf(line, sizeof(line), "  segment '%s' F1", s.segments[0][seg].event.c_str());
+    out += line;
+    for (int k : core::trainableClasses()) {
+      if (s.ceiling[seg].truthCount(k) == 0) continue;
+      std::snprintf(line, sizeof(line), "  %s", core::className(k));
+      out += line;
+      for (size_t m = 0; m < s.mode_names.size(); ++m) {
+        const auto& a = s.segments[m][seg].adapted;
+        std::snprintf(line, sizeof(line), " %.2f", f1(a.recall(k), a.precision(k)));
+        out += line;
+      }
+      std::snprintf(line, sizeof(line), " [%.2f]", f1(s.ceiling[seg].recall(k), s.ceiling[seg].precision(k)));
+      out += line;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+}  // namespace sim
+}  // namespace act_color
