@@ -1,6 +1,8 @@
 // Writes the simulator's scenarios as bags in the contract's topics, with truth, no ROS master needed:
 //   act_make_scenarios --calibration CAL.yaml --scenario NAME|all --length small|full --output-dir DIR
 //                      [--seed N] [--png DIR] [--compression none|lz4|bz2]
+//   act_make_scenarios --family SEED --length small|full --output-dir DIR [--png DIR] [--compression ...]
+//     writes the randomized family's scene SEED as family_SEED.bag and its calibration family_SEED.yaml
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/time.h>
 #include <rosbag/bag.h>
@@ -13,8 +15,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
@@ -25,6 +29,7 @@
 #include "act_color/core/segmenter.hpp"
 #include "act_color/sim/renderer.hpp"
 #include "act_color/sim/scenario.hpp"
+#include "act_color/sim/scene_family.hpp"
 
 namespace {
 
@@ -37,7 +42,9 @@ const ros::Time kStartTime(1183300000, 0);
 
 const char* const kUsage =
     "usage: act_make_scenarios --calibration CAL.yaml --scenario NAME|all --length small|full\n"
-    "                          --output-dir DIR [--seed N] [--png DIR] [--compression none|lz4|bz2]\n";
+    "                          --output-dir DIR [--seed N] [--png DIR] [--compression none|lz4|bz2]\n"
+    "       act_make_scenarios --family SEED --length small|full --output-dir DIR [--png DIR]\n"
+    "                          [--compression none|lz4|bz2]\n";
 
 int badArguments(const std::string& message) {
   std::cerr << "act_make_scenarios: " << message << "\n" << kUsage;
@@ -93,8 +100,8 @@ void writePng(const std::string& path, const cv::Mat& rgb) {
 
 int main(int argc, char** argv) {
   std::map<std::string, std::string> args;
-  static const std::vector<std::string> kOptions = {"--calibration", "--scenario", "--length",     "--output-dir",
-                                                    "--seed",        "--png",      "--compression"};
+  static const std::vector<std::string> kOptions = {"--calibration", "--scenario", "--length",      "--output-dir",
+                                                    "--seed",        "--png",      "--compression", "--family"};
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") {
@@ -107,7 +114,15 @@ int main(int argc, char** argv) {
     if (args.count(a)) return badArguments(a + " given twice");
     args[a] = argv[++i];
   }
+  const bool family = args.count("--family") > 0;
+  if (family) {
+    // The family scene brings its own camera and field, and its seed is the scene.
+    for (const char* other : {"--calibration", "--scenario", "--seed"}) {
+      if (args.count(other)) return badArguments(std::string("--family and ") + other + " exclude each other");
+    }
+  }
   for (const char* required : {"--calibration", "--scenario", "--length", "--output-dir"}) {
+    if (family && (std::string(required) == "--calibration" || std::string(required) == "--scenario")) continue;
     if (!args.count(required)) return badArguments(std::string("missing ") + required);
   }
   sim::ScenarioLength length;
@@ -115,7 +130,9 @@ int main(int argc, char** argv) {
     return badArguments("--length must be small or full, is '" + args["--length"] + "'");
   }
   std::vector<std::string> names;
-  if (args["--scenario"] == "all") {
+  if (family) {
+    // One scene, named after its seed.
+  } else if (args["--scenario"] == "all") {
     names = sim::scenarioNames();
   } else {
     const auto& known = sim::scenarioNames();
@@ -127,12 +144,13 @@ int main(int argc, char** argv) {
     names = {args["--scenario"]};
   }
   uint32_t seed = 1;
-  if (args.count("--seed")) {
-    const std::string& text = args["--seed"];
+  const char* const seed_option = family ? "--family" : "--seed";
+  if (args.count(seed_option)) {
+    const std::string& text = args[seed_option];
     char* end = nullptr;
     const unsigned long value = std::strtoul(text.c_str(), &end, 10);
     if (text.empty() || text[0] == '-' || *end != '\0' || value > 0xFFFFFFFFul) {
-      return badArguments("--seed must be an integer in [0, 4294967295], is '" + text + "'");
+      return badArguments(std::string(seed_option) + " must be an integer in [0, 4294967295], is '" + text + "'");
     }
     seed = static_cast<uint32_t>(value);
   }
@@ -150,10 +168,12 @@ int main(int argc, char** argv) {
     }
   }
   act_color::core::Calibration calibration;
-  try {
-    calibration = act_color::core::loadCalibration(args["--calibration"]);
-  } catch (const std::exception& e) {
-    return badArguments(std::string("bad calibration: ") + e.what());
+  if (!family) {
+    try {
+      calibration = act_color::core::loadCalibration(args["--calibration"]);
+    } catch (const std::exception& e) {
+      return badArguments(std::string("bad calibration: ") + e.what());
+    }
   }
 
   try {
@@ -165,11 +185,33 @@ int main(int argc, char** argv) {
       std::filesystem::create_directories(png_dir);
     }
     ros::Time::init();
-    const sim::Renderer renderer(calibration);
     const std::string length_name = length == sim::ScenarioLength::kSmall ? "small" : "full";
-    for (const std::string& name : names) {
-      const sim::Scenario scenario = sim::makeScenario(name, length, calibration, seed);
-      const std::string path = (out_dir / (name + "_" + length_name + ".bag")).string();
+    // What to write: a file stem, the scenario and the renderer of its camera and hall.
+    struct Job {
+      std::string stem;
+      sim::Scenario scenario;
+      std::shared_ptr<const sim::Renderer> renderer;
+    };
+    std::vector<Job> jobs;
+    if (family) {
+      const sim::FamilyScene scene = sim::makeFamilyScene(seed, length);
+      const std::string stem = "family_" + std::to_string(seed);
+      const std::string yaml_path = (out_dir / (stem + ".yaml")).string();
+      std::ofstream yaml(yaml_path);
+      yaml << "# " << scene.summary << "\n" << act_color::core::toYaml(scene.calibration);
+      if (!yaml.flush()) throw std::runtime_error("cannot write " + yaml_path);
+      std::printf("%s\nwrote %s\n", scene.summary.c_str(), yaml_path.c_str());
+      jobs.push_back({stem, scene.scenario, std::make_shared<const sim::Renderer>(scene.calibration, scene.renderer)});
+    } else {
+      const auto renderer = std::make_shared<const sim::Renderer>(calibration);
+      for (const std::string& name : names) {
+        jobs.push_back({name + "_" + length_name, sim::makeScenario(name, length, calibration, seed), renderer});
+      }
+    }
+    for (const Job& job : jobs) {
+      const sim::Scenario& scenario = job.scenario;
+      const sim::Renderer& renderer = *job.renderer;
+      const std::string path = (out_dir / (job.stem + ".bag")).string();
       rosbag::Bag bag(path, rosbag::bagmode::Write);
       bag.setCompression(compression);
       std::string event_list;
@@ -214,7 +256,7 @@ int main(int argc, char** argv) {
         bool first_of_event = false;
         for (const std::string& event : frame.events) first_of_event |= png_events.insert(event).second;
         if (!png_dir.empty() && (i == 0 || first_of_event)) {
-          const std::string stem = (png_dir / (name + "_" + length_name + "_" + std::to_string(i))).string();
+          const std::string stem = (png_dir / (job.stem + "_" + std::to_string(i))).string();
           writePng(stem + "_image.png", rendered.rgb);
           cv::Mat colored;
           act_color::core::colorizeLabels(rendered.labels, colored);
