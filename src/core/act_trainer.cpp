@@ -103,6 +103,74 @@ void ActParams::validate() const {
   requireRange("reacquire_cycles", reacquire_cycles, 0, 1000);
 }
 
+void ActParams::set(const std::string& name, const std::string& value) {
+  auto number = [&]() {
+    size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != value.size() || value.empty()) throw std::invalid_argument(name + ": '" + value + "' is not a number");
+    return v;
+  };
+  auto integer = [&]() {
+    const double v = number();
+    if (v != std::floor(v) || std::abs(v) > 1e9)
+      throw std::invalid_argument(name + ": '" + value + "' is not an integer");
+    return static_cast<int>(v);
+  };
+  auto boolean = [&]() {
+    if (value == "true" || value == "1") return true;
+    if (value == "false" || value == "0") return false;
+    throw std::invalid_argument(name + ": '" + value + "' is not true or false");
+  };
+  if (name == "eta") {
+    eta = number();
+  } else if (name == "zeta") {
+    zeta = number();
+  } else if (name == "xi") {
+    xi = number();
+  } else if (name == "sigma_min") {
+    sigma_min = number();
+  } else if (name == "cluster_stride") {
+    cluster_stride = integer();
+  } else if (name == "add_stride") {
+    add_stride = integer();
+  } else if (name == "remove_stride") {
+    remove_stride = integer();
+  } else if (name == "lut_bits") {
+    lut_bits = integer();
+  } else if (name == "white_filter") {
+    white_filter = boolean();
+  } else if (name == "seed") {
+    seed = static_cast<uint32_t>(integer());
+  } else if (name == "seed_clusters") {
+    seed_clusters = boolean();
+  } else if (name == "add_neighbourhood_cells") {
+    add_neighbourhood_cells = integer();
+  } else if (name == "robust_clusters") {
+    robust_clusters = boolean();
+  } else if (name == "light_compensation") {
+    light_compensation = boolean();
+  } else if (name == "light_change_add_stride") {
+    light_change_add_stride = integer();
+  } else if (name == "removal_protect_cycles") {
+    removal_protect_cycles = integer();
+  } else if (name == "robots_train_black") {
+    robots_train_black = boolean();
+  } else if (name == "nearest_mean") {
+    nearest_mean = boolean();
+  } else if (name == "evidence_removal_ratio") {
+    evidence_removal_ratio = number();
+  } else if (name == "reacquire_cycles") {
+    reacquire_cycles = integer();
+  } else {
+    throw std::invalid_argument("unknown ACT parameter '" + name + "'");
+  }
+}
+
 void ActParams::switchOffExtensions() {
   seed_clusters = false;
   add_neighbourhood_cells = 0;
@@ -247,7 +315,9 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
 }
 
 uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
-  if (k != kGreen || !params_.robots_train_black) return k;
+  // Robots stand on the carpet and in front of the goals: there, a robot's color is what the pose
+  // cannot foresee.
+  if ((k != kGreen && k != kYellow && k != kBlue) || !params_.robots_train_black) return k;
   const ClassCluster& green = clusters_[kGreen];
   if (!green.trained()) return k;
   const int lo = std::min({c[0], c[1], c[2]});
@@ -481,22 +551,6 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
   light_.observe(samples_[kGreen], samples_[kWhite], chassis_samples_);
   const ClusterParams cluster_params = clusterParams();
-  if (params_.robust_clusters) {
-    // Colors that firmly belong to another class train neither cluster nor table for k.
-    for (int k = 1; k < kNumClasses; ++k) {
-      auto& s = samples_[k];
-      s.erase(std::remove_if(s.begin(), s.end(),
-                             [&](const Eigen::Vector3f& c) {
-                               const uint8_t current = lut_.classOf(
-                                   static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]), static_cast<uint8_t>(c[2]));
-                               const Eigen::Vector3d color = c.cast<double>();
-                               return claimedByOtherClass(color, current, static_cast<uint8_t>(k)) &&
-                                      (clusters_[current].mean() - color).norm() <
-                                          params_.zeta * clusters_[current].sigma();
-                             }),
-              s.end());
-    }
-  }
   const ClassCluster& green = clusters_[kGreen];
   LightModel::Map light_map;
   auto lightMoved = [&] {
@@ -532,6 +586,26 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     stats.light_change = true;
   } else {
     light_.follow(params_.eta);
+  }
+  if (params_.robust_clusters) {
+    // Re-acquisition, on all colors seen where each robust class is expected.
+    for (int k = 1; k < kNumClasses; ++k) {
+      if (k != kGreen && clusters_[k].reacquireIfLost(samples_[k], cluster_params)) ++stats.reacquired;
+    }
+    // Colors that firmly belong to another class train neither cluster nor table for k.
+    for (int k = 1; k < kNumClasses; ++k) {
+      auto& s = samples_[k];
+      s.erase(std::remove_if(s.begin(), s.end(),
+                             [&](const Eigen::Vector3f& c) {
+                               const uint8_t current = lut_.classOf(
+                                   static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]), static_cast<uint8_t>(c[2]));
+                               const Eigen::Vector3d color = c.cast<double>();
+                               return claimedByOtherClass(color, current, static_cast<uint8_t>(k)) &&
+                                      (clusters_[current].mean() - color).norm() <
+                                          params_.zeta * clusters_[current].sigma();
+                             }),
+              s.end());
+    }
   }
   // Green (the carpet) and black (the own chassis) first: they are seen where expected whatever
   // else is on the field, and the goals then leave out colors that are theirs (a robot in front of

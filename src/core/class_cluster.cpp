@@ -69,15 +69,6 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
   for (const auto& c : colors) {
     if ((c.cast<double>() - mean_).norm() < radius) inliers_.push_back(c);
   }
-  // Re-acquisition: the colors seen where the class is expected stopped fitting the cluster.
-  constexpr size_t kMinColorsToJudge = 4;
-  if (params.reacquire_cycles > 0 && colors.size() >= kMinColorsToJudge) {
-    misfit_cycles_ = 4 * inliers_.size() < colors.size() ? misfit_cycles_ + 1 : 0;
-    if (misfit_cycles_ >= params.reacquire_cycles) {
-      seedRobustly(colors, params);
-      return last_samples_;
-    }
-  }
   if (inliers_.size() < 2) {
     last_samples_ = 0;
     return 0;
@@ -102,6 +93,18 @@ unsigned ClassCluster::updateFromInliers(const std::vector<Eigen::Vector3f>& col
   sigma_ = std::max((params.eta * sigma_ + spread) / (params.eta + 1.0), params.sigma_min);
   last_samples_ = static_cast<unsigned>(inliers_.size());
   return last_samples_;
+}
+
+bool ClassCluster::reacquireIfLost(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params) {
+  constexpr size_t kMinColorsToJudge = 4;
+  if (params.reacquire_cycles <= 0 || !trained_ || colors.size() < kMinColorsToJudge) return false;
+  const double radius = params.zeta * sigma_;
+  size_t fitting = 0;
+  for (const auto& c : colors) fitting += (c.cast<double>() - mean_).norm() < radius;
+  misfit_cycles_ = 4 * fitting < colors.size() ? misfit_cycles_ + 1 : 0;
+  if (misfit_cycles_ < params.reacquire_cycles) return false;
+  seedRobustly(colors, params);
+  return true;
 }
 
 void ClassCluster::seedRobustly(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params) {

@@ -17,8 +17,8 @@ constexpr int kGreenAnchor = 1;
 // Slopes of one channel's map between the anchor classes' medians may differ by this factor
 // (gamma 1.6 between chassis, carpet and lines: about 1.6; a carpet turned magenta: 19).
 constexpr double kMaxSlopeSpread = 4.0;
-// The channels' gains at the carpet may differ by this factor (color temperature, white balance).
-constexpr double kMaxGainSpread = 2.5;
+// The channels' slopes may differ by this factor (color temperature, white balance: about 1.8).
+constexpr double kMaxChannelSlopeSpread = 2.5;
 // Anchor medians closer than this (channel units) tell no slope.
 constexpr double kMinAnchorDistance = 8.0;
 constexpr double kMinExtrapolationBase = 24.0;
@@ -53,15 +53,26 @@ void LightModel::observe(const std::vector<Eigen::Vector3f>& green, const std::v
     const auto& s = *samples[a];
     if (s.size() < kMinSamples[a]) continue;
     q.assign(kLevels[a].size(), Eigen::Vector3d::Zero());
-    scratch_.resize(s.size());
+    // Quantiles from a histogram per channel (colors are 8-bit): linear in the samples, no sort.
     for (int c = 0; c < 3; ++c) {
-      for (size_t i = 0; i < s.size(); ++i) scratch_[i] = s[i][c];
-      std::sort(scratch_.begin(), scratch_.end());
+      histogram_.fill(0);
+      for (const auto& color : s) ++histogram_[static_cast<uint8_t>(color[c])];
+      uint32_t below = 0;  // samples in the bins before `bin`
+      int bin = 0;
       for (size_t l = 0; l < kLevels[a].size(); ++l) {
+        // The sample of rank pos (0-based, fractional) among the sorted values.
         const double pos = kLevels[a][l] * static_cast<double>(s.size() - 1);
-        const size_t lo = static_cast<size_t>(pos);
-        const size_t hi = std::min(s.size() - 1, lo + 1);
-        q[l][c] = scratch_[lo] + (pos - lo) * (scratch_[hi] - scratch_[lo]);
+        while (below + histogram_[bin] <= pos) below += histogram_[bin++];
+        const double rank_lo = std::floor(pos);
+        const double value_lo = bin;
+        // The next rank may lie in a later bin.
+        double value_hi = value_lo;
+        if (rank_lo + 1 < s.size() && below + histogram_[bin] <= rank_lo + 1) {
+          int next = bin + 1;
+          while (next < 255 && histogram_[next] == 0) ++next;
+          value_hi = next;
+        }
+        q[l][c] = value_lo + (pos - rank_lo) * (value_hi - value_lo);
       }
     }
   }
@@ -72,17 +83,7 @@ void LightModel::observe(const std::vector<Eigen::Vector3f>& green, const std::v
 bool LightModel::estimate(ColorSpace space, Map* map) const {
   if (!has_reference_ || !observed_green_ || reference_.quantiles[kGreenAnchor].empty()) return false;
   const Eigen::Vector3d pivot = space == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
-  // The channels' gains at the carpet about their zero (0, or 128 for chroma).
-  double gain_min = 1e9, gain_max = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    const double from = reference_green_median_[c] - pivot[c];
-    if (std::abs(from) < kMinAnchorDistance) continue;
-    const double gain = (current_green_median_[c] - pivot[c]) / from;
-    gain_min = std::min(gain_min, gain);
-    gain_max = std::max(gain_max, gain);
-  }
-  if (gain_max <= 0.0 || gain_min <= 0.0 || gain_max > kMaxGainSpread * gain_min) return false;
-
+  std::array<double, 3> channel_slope = {0.0, 0.0, 0.0};  // 0: no slope seen in the channel
   for (int c = 0; c < 3; ++c) {
     // Anchor points (before, after), and the anchor classes' medians for the slope check.
     std::vector<std::pair<double, double>> points, medians;
@@ -116,6 +117,7 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
       slope_max = std::max(slope_max, slope);
     }
     if (slope_max > 0.0 && (slope_min <= 0.0 || slope_max > kMaxSlopeSpread * slope_min)) return false;
+    if (slope_max > 0.0) channel_slope[c] = std::sqrt(slope_min * slope_max);
     // Points with (nearly) the same input are one point; then outputs made non-decreasing by
     // pooling adjacent violators.
     std::sort(points.begin(), points.end());
@@ -179,7 +181,14 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
       map->f[c][x] = std::clamp(y, 0.0, 256.0);
     }
   }
-  return true;
+  // One light changes the channels alike up to its color (white balance, color temperature).
+  double lo = 1e9, hi = 0.0;
+  for (const double slope : channel_slope) {
+    if (slope <= 0.0) continue;
+    lo = std::min(lo, slope);
+    hi = std::max(hi, slope);
+  }
+  return hi <= kMaxChannelSlopeSpread * lo || hi == 0.0;
 }
 
 void LightModel::follow(double eta) {

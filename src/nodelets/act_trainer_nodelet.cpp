@@ -129,6 +129,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
   params.robots_train_black = pnh_.param("robots_train_black", params.robots_train_black);
   params.nearest_mean = pnh_.param("nearest_mean", params.nearest_mean);
   params.evidence_removal_ratio = pnh_.param("evidence_removal_ratio", params.evidence_removal_ratio);
+  params.reacquire_cycles = pnh_.param("reacquire_cycles", params.reacquire_cycles);
   try {
     params.validate();
   } catch (const std::exception& e) {

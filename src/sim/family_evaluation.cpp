@@ -89,6 +89,7 @@ std::vector<EvalMode> evalModes(bool ablations) {
       {"robots_train_black", [](core::ActParams& p) { p.robots_train_black = false; }},
       {"nearest_mean", [](core::ActParams& p) { p.nearest_mean = false; }},
       {"evidence_removal_ratio", [](core::ActParams& p) { p.evidence_removal_ratio = 0; }},
+      {"reacquire_cycles", [](core::ActParams& p) { p.reacquire_cycles = 0; }},
   };
   for (const auto& [name, apply] : off) {
     EvalMode m{"no_" + name, core::ActParams()};

@@ -11,21 +11,25 @@
 #include <string>
 #include <vector>
 
+#include "act_color/core/act_trainer.hpp"
 #include "act_color/sim/family_evaluation.hpp"
 #include "act_color/sim/scene_family.hpp"
 
 namespace {
 
+namespace core = act_color::core;
 namespace sim = act_color::sim;
 
 const char* const kUsage =
     "usage: act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full]\n"
-    "                [--ablate] [--per-scene] [--png DIR]\n"
+    "                [--ablate] [--set NAME=VALUE] [--mode NAME:N=V,...] [--per-scene] [--png DIR]\n"
     "  --split S     report: seeds 1000-1099 (default); tuning: seeds 0-99\n"
     "  --seeds A-B   any range of seeds instead (inclusive)\n"
     "  --count N     only the first N seeds of the range (a quick subset)\n"
     "  --length L    small (default, 40-60 frames per scene) or full\n"
     "  --ablate      also the defaults with each extension off in turn\n"
+    "  --set N=V     an ACT parameter for every mode but the paper's (repeatable), e.g. zeta=3\n"
+    "  --mode M:N=V,N=V  one more mode: the defaults with these parameters (repeatable)\n"
     "  --per-scene   one line per scene and segment: F1 per class and mode, [ceiling]\n"
     "  --png DIR     input | labels of each mode | truth, for the last frame of every segment\n";
 
@@ -42,6 +46,8 @@ int main(int argc, char** argv) {
   sim::ScenarioLength length = sim::ScenarioLength::kSmall;
   bool ablate = false, per_scene = false;
   sim::EvalOptions options;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  std::vector<std::string> extra_modes;
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
@@ -79,6 +85,13 @@ int main(int argc, char** argv) {
         ablate = true;
       } else if (arg == "--per-scene") {
         per_scene = true;
+      } else if (arg == "--set") {
+        const std::string s = value();
+        const size_t eq = s.find('=');
+        if (eq == std::string::npos) return usage("--set wants name=value");
+        overrides.emplace_back(s.substr(0, eq), s.substr(eq + 1));
+      } else if (arg == "--mode") {
+        extra_modes.push_back(value());
       } else if (arg == "--png") {
         options.png_dir = value();
       } else {
@@ -91,7 +104,33 @@ int main(int argc, char** argv) {
   if (count > 0 && first + static_cast<uint32_t>(count) < end) end = first + static_cast<uint32_t>(count);
 
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<sim::EvalMode> modes = sim::evalModes(ablate);
+  std::vector<sim::EvalMode> modes = sim::evalModes(ablate);
+  try {
+    for (auto& m : modes) {
+      if (m.name == "paper") continue;
+      for (const auto& [name, value] : overrides) m.params.set(name, value);
+      m.params.validate();
+    }
+    // --mode NAME:a=1,b=2 : the defaults (with --set) and these parameters.
+    const core::ActParams base = modes.front().params;
+    for (const std::string& text : extra_modes) {
+      const size_t colon = text.find(':');
+      sim::EvalMode m{text.substr(0, colon), base};
+      std::string rest = colon == std::string::npos ? "" : text.substr(colon + 1);
+      while (!rest.empty()) {
+        const size_t comma = rest.find(',');
+        const std::string item = rest.substr(0, comma);
+        const size_t eq = item.find('=');
+        if (eq == std::string::npos) throw std::invalid_argument("--mode wants NAME:a=1,b=2, not '" + text + "'");
+        m.params.set(item.substr(0, eq), item.substr(eq + 1));
+        rest = comma == std::string::npos ? "" : rest.substr(comma + 1);
+      }
+      m.params.validate();
+      modes.push_back(m);
+    }
+  } catch (const std::invalid_argument& e) {
+    return usage(e.what());
+  }
   std::vector<sim::SceneResult> results;
   double render = 0, act = 0;
   size_t frames = 0;

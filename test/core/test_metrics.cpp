@@ -3,6 +3,8 @@
 #include <cmath>
 
 #include "act_color/core/metrics.hpp"
+#include "act_color/core/segmenter.hpp"
+#include "act_color/core/table_ceiling.hpp"
 
 using namespace act_color::core;
 
@@ -34,4 +36,39 @@ TEST(Metrics, RecallPrecisionFitness) {
 TEST(Metrics, SizeMismatchThrows) {
   ClassificationMetrics m;
   EXPECT_THROW(m.add(cv::Mat::zeros(2, 2, CV_8UC1), cv::Mat::zeros(3, 2, CV_8UC1)), std::invalid_argument);
+}
+
+TEST(TableCeiling, MajorityOfTheTruthPerColorCell) {
+  // Five pixels of one color: three green, two white in truth -> the cell is green; a second color
+  // only white; a third color only outside the mirror (skipped).
+  cv::Mat rgb(1, 8, CV_8UC3);
+  const cv::Vec3b a(40, 140, 50), b(230, 230, 230), c(10, 10, 200);
+  for (int u = 0; u < 5; ++u) rgb.at<cv::Vec3b>(0, u) = a;
+  rgb.at<cv::Vec3b>(0, 5) = b;
+  rgb.at<cv::Vec3b>(0, 6) = c;
+  rgb.at<cv::Vec3b>(0, 7) = c;
+  const cv::Mat truth = (cv::Mat_<uint8_t>(1, 8) << 1, 1, 1, 2, 2, 2, 255, 255);
+  TableCeiling ceiling;
+  ceiling.add(ImageView::fromMat(rgb, PixelFormat::kRgb8), truth);
+  EXPECT_EQ(ceiling.pixels(), 6u);
+  const ColorLut table = ceiling.table();
+  EXPECT_EQ(table.classOf(a[0], a[1], a[2]), kGreen);
+  EXPECT_EQ(table.classOf(b[0], b[1], b[2]), kWhite);
+  EXPECT_EQ(table.classOf(c[0], c[1], c[2]), kUnknown);
+  // The table's own metrics: green 3/3 recall, 3/5 precision; white 1/3 recall, 1/1 precision.
+  const ClassificationMetrics m = ceiling.metrics();
+  EXPECT_DOUBLE_EQ(m.recall(kGreen), 1.0);
+  EXPECT_DOUBLE_EQ(m.precision(kGreen), 0.6);
+  EXPECT_DOUBLE_EQ(m.recall(kWhite), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(m.precision(kWhite), 1.0);
+  // The same as classifying the frame with the table.
+  cv::Mat labels;
+  Segmenter().classify(table, ImageView::fromMat(rgb, PixelFormat::kRgb8), labels);
+  ClassificationMetrics direct;
+  direct.add(labels, truth);
+  EXPECT_EQ(direct.confusion(), m.confusion());
+  ceiling.clear();
+  EXPECT_EQ(ceiling.pixels(), 0u);
+  EXPECT_THROW(ceiling.add(ImageView::fromMat(rgb, PixelFormat::kRgb8), cv::Mat::zeros(2, 8, CV_8UC1)),
+               std::invalid_argument);
 }

@@ -60,9 +60,9 @@ struct ActParams {
   // poster like a robot) stay with the class that needs them. 0: the paper's removal.
   int removal_protect_cycles = 10;
   // Black is the own chassis and the other robots, but the chassis alone is lit differently from
-  // robots elsewhere on the field: a color expected green that is far from green (beyond
+  // robots elsewhere on the field: a color expected green or a goal that is far from green (beyond
   // zeta * sigma), dark (intensity below 60% of green's) and unsaturated is a robot standing on
-  // the carpet and trains black instead.
+  // the carpet or in front of a goal and trains black instead.
   bool robots_train_black = true;
   // A color joins class k only when k's cluster mean is the nearest of the trained clusters'
   // means: the table splits mixed colors (the blurred edge of a line on the carpet) where they are
@@ -80,6 +80,9 @@ struct ActParams {
   int reacquire_cycles = 3;
 
   void validate() const;
+  // Sets the parameter `name` (as the field is named) from text; throws std::invalid_argument for
+  // an unknown name or a value that does not parse. validate() checks the range.
+  void set(const std::string& name, const std::string& value);
   // Every extension off: the paper's algorithm exactly.
   void switchOffExtensions();
   static ActParams paper();
@@ -98,6 +101,7 @@ struct CycleStats {
   uint32_t doublings = 0;                               // sigma doublings over all clusters
   bool color_space_changed = false;                     // table reset for a new color space
   bool light_change = false;                            // light compensation applied
+  uint32_t reacquired = 0;                              // clusters seeded again (reacquire_cycles)
   Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain at the carpet's color
 };
 

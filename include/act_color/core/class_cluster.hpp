@@ -52,6 +52,12 @@ class ClassCluster {
   // inliers used.
   unsigned updateFromInliers(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
 
+  // ClusterParams::reacquire_cycles: counts the cycles in a row in which fewer than a quarter of
+  // `colors` (all colors expected for the class, at least 4) lie within zeta * sigma, and seeds the
+  // cluster again from them (per-channel median, median distance) when they reach the limit.
+  // Returns true when it did. Untrained clusters are left to their first update.
+  bool reacquireIfLost(const std::vector<Eigen::Vector3f>& colors, const ClusterParams& params);
+
   // A global change of light (LightModel): the mean moves to where the light maps it, sigma
   // scales with the map's slope there.
   void applyLightChange(const Eigen::Vector3d& mean, double sigma_scale, const ClusterParams& params);

@@ -59,7 +59,7 @@ class LightModel {
   bool observed_green_ = false;
   Eigen::Vector3d current_green_median_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d reference_green_median_ = Eigen::Vector3d::Zero();
-  std::vector<float> scratch_;
+  std::array<uint32_t, 256> histogram_{};  // scratch
 };
 
 }  // namespace core

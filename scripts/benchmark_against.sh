@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# The ACT cycle of this checkout against another revision's, measured in one run: builds REV
+# (default: the last commit before issue 11's work, eece390) in its own workspace, then runs both
+# act_benchmark binaries in turn (580x580, one core, three rounds) and prints the medians and
+# their ratio (issue 11: at most 1.3x).
+#   scripts/benchmark_against.sh [REV] [--rounds N]
+set -eo pipefail
+source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
+rev=eece390
+rounds=3
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --rounds) rounds=$2; shift 2 ;;
+    -*) echo "usage: $0 [REV] [--rounds N]" >&2; exit 2 ;;
+    *) rev=$1; shift ;;
+  esac
+done
+act_install_deps
+act_build
+ours="$ACT_WS/devel/lib/act_color/act_benchmark"
+base_src="$ACT_WS/baseline-$rev/src"
+base_ws="$ACT_WS/baseline-$rev/ws"
+if [ ! -x "$base_ws/devel/lib/act_color/act_benchmark" ]; then
+  rm -rf "$base_src"
+  mkdir -p "$base_src"
+  git -C "$ACT_ROOT" archive "$rev" | tar -x -C "$base_src"
+  (ACT_ROOT="$base_src" ACT_WS="$base_ws" && export ACT_ROOT ACT_WS && mkdir -p "$ACT_WS/src" &&
+    ln -sfn "$ACT_ROOT" "$ACT_WS/src/act_color" &&
+    catkin_make -C "$ACT_WS" -j"$(nproc)" act_benchmark -DCMAKE_BUILD_TYPE=Release \
+      -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 >"$ACT_WS.log" 2>&1) ||
+    { tail -n 40 "$base_ws.log"; echo "act_color: could not build $rev" >&2; exit 1; }
+fi
+base="$base_ws/devel/lib/act_color/act_benchmark"
+cpu=$(( $(nproc) - 1 ))
+echo "act_color: ACT cycle at 580x580, $rev vs this checkout, $rounds rounds (load $(cut -d' ' -f1-3 /proc/loadavg))"
+declare -a b o
+for _ in $(seq "$rounds"); do
+  b+=("$("$base" --no-ros --sizes 580x580 --samples 15 --cpu "$cpu" | awk '$2 == "act_cycle" {print $3}')")
+  o+=("$("$ours" --no-ros --sizes 580x580 --samples 15 --cpu "$cpu" | awk '$2 == "act_cycle" {print $3}')")
+done
+median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
+mb=$(median "${b[@]}")
+mo=$(median "${o[@]}")
+echo "  $rev: ${b[*]} ms (median $mb)"
+echo "  this checkout: ${o[*]} ms (median $mo)"
+awk -v b="$mb" -v o="$mo" 'BEGIN {printf "  ratio (this / %s): %.2fx\n", "'"$rev"'", o / b}'

@@ -1,0 +1,46 @@
+// act_eval's machinery on a few scenes of the tuning split: every mode sees the same frames, the
+// ceiling is computed per segment, and the report's statistics follow from the units.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "act_color/sim/family_evaluation.hpp"
+#include "act_color/sim/scene_family.hpp"
+
+namespace act_color {
+namespace {
+
+TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
+  const std::vector<sim::EvalMode> modes = sim::evalModes(false);
+  ASSERT_EQ(modes.size(), 2u);
+  EXPECT_EQ(modes[0].name, "defaults");
+  EXPECT_EQ(modes[1].name, "paper");
+  std::vector<sim::SceneResult> results;
+  for (uint32_t seed : {sim::kTuningSeedsBegin, sim::kTuningSeedsBegin + 1}) {
+    results.push_back(sim::evaluateScene(sim::makeFamilyScene(seed), modes, sim::EvalOptions()));
+    const sim::SceneResult& r = results.back();
+    ASSERT_EQ(r.segments.size(), 2u);
+    ASSERT_EQ(r.segments[0].size(), r.ceiling.size());  // one ceiling per segment
+    ASSERT_EQ(r.segments[1].size(), r.ceiling.size());
+    EXPECT_GE(r.ceiling.size(), 2u);  // every family scene has an event
+    for (size_t s = 0; s < r.ceiling.size(); ++s) {
+      // Both modes and the ceiling count the same truth pixels after adaptation.
+      EXPECT_EQ(r.segments[0][s].adapted.truthCount(core::kGreen), r.ceiling[s].truthCount(core::kGreen));
+      EXPECT_EQ(r.segments[1][s].adapted.truthCount(core::kGreen), r.ceiling[s].truthCount(core::kGreen));
+    }
+  }
+  const sim::FamilyReport report = sim::summarize(results);
+  ASSERT_EQ(report.recall.size(), 3u);  // defaults, paper, ceiling
+  for (int k : {core::kGreen, core::kWhite}) {
+    EXPECT_GE(report.recall[0][k].count, 4u) << core::className(k);
+    EXPECT_LE(report.recall[0][k].worst, report.recall[0][k].p10);
+    EXPECT_LE(report.recall[0][k].p10, report.recall[0][k].median);
+    EXPECT_GE(report.recall_gap[0][k].worst, report.recall_gap[0][k].median);
+  }
+  const std::string text = sim::formatReport(report);
+  EXPECT_NE(text.find("ceiling"), std::string::npos);
+  EXPECT_NE(text.find("F1 below the paper"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace act_color
