@@ -100,7 +100,6 @@ void ActParams::validate() const {
   requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
   requireRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
   requireRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
-  requireRange("reacquire_cycles", reacquire_cycles, 0, 1000);
 }
 
 void ActParams::set(const std::string& name, const std::string& value) {
@@ -146,12 +145,8 @@ void ActParams::set(const std::string& name, const std::string& value) {
     white_filter = boolean();
   } else if (name == "seed") {
     seed = static_cast<uint32_t>(integer());
-  } else if (name == "seed_clusters") {
-    seed_clusters = boolean();
   } else if (name == "add_neighbourhood_cells") {
     add_neighbourhood_cells = integer();
-  } else if (name == "robust_clusters") {
-    robust_clusters = boolean();
   } else if (name == "light_compensation") {
     light_compensation = boolean();
   } else if (name == "light_change_add_stride") {
@@ -164,23 +159,18 @@ void ActParams::set(const std::string& name, const std::string& value) {
     nearest_mean = boolean();
   } else if (name == "evidence_removal_ratio") {
     evidence_removal_ratio = number();
-  } else if (name == "reacquire_cycles") {
-    reacquire_cycles = integer();
   } else {
     throw std::invalid_argument("unknown ACT parameter '" + name + "'");
   }
 }
 
 void ActParams::switchOffExtensions() {
-  seed_clusters = false;
   add_neighbourhood_cells = 0;
-  robust_clusters = false;
   light_compensation = false;
   removal_protect_cycles = 0;
   robots_train_black = false;
   nearest_mean = false;
   evidence_removal_ratio = 0;
-  reacquire_cycles = 0;
 }
 
 ActParams ActParams::paper() {
@@ -247,8 +237,6 @@ ClusterParams ActTrainer::clusterParams() const {
   p.eta = params_.eta;
   p.sigma_min = params_.sigma_min;
   p.zeta = params_.zeta;
-  p.seed_from_first_samples = params_.seed_clusters;
-  p.reacquire_cycles = params_.reacquire_cycles;
   return p;
 }
 
@@ -259,7 +247,6 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   if ((cluster.mean() - color).norm() >= radius) return 0;  // 2.3: |mu_k - c| < zeta sigma_k
   uint32_t changed = 0;
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
-  if (params_.robust_clusters && claimedByOtherClass(color, lut_.at(cell), k)) return 0;
   if (nearerToOtherMean(color, k)) return 0;
   const uint32_t this_cycle = static_cast<uint32_t>(revision_ + 1);
   if (params_.evidence_removal_ratio > 0) {
@@ -357,22 +344,6 @@ bool ActTrainer::nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) cons
     if (b.normal.dot(color) < b.offset) return true;
   }
   return false;
-}
-
-void ActTrainer::dropColorsOfOtherClusters(std::vector<Eigen::Vector3f>& colors, uint8_t k) const {
-  const ClassCluster& own = clusters_[k];
-  auto belongsElsewhere = [&](const Eigen::Vector3f& c) {
-    const Eigen::Vector3d color = c.cast<double>();
-    for (const int j : {kGreen, kBlack}) {
-      const ClassCluster& other = clusters_[j];
-      if (j == k || !other.trained()) continue;
-      const double to_other = (other.mean() - color).norm();
-      if (to_other >= params_.zeta * other.sigma()) continue;
-      if (!own.trained() || to_other / other.sigma() < (own.mean() - color).norm() / own.sigma()) return true;
-    }
-    return false;
-  };
-  colors.erase(std::remove_if(colors.begin(), colors.end(), belongsElsewhere), colors.end());
 }
 
 bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const {
@@ -587,38 +558,10 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   } else {
     light_.follow(params_.eta);
   }
-  if (params_.robust_clusters) {
-    // Re-acquisition, on all colors seen where each robust class is expected.
-    for (int k = 1; k < kNumClasses; ++k) {
-      if (k != kGreen && clusters_[k].reacquireIfLost(samples_[k], cluster_params)) ++stats.reacquired;
-    }
-    // Colors that firmly belong to another class train neither cluster nor table for k.
-    for (int k = 1; k < kNumClasses; ++k) {
-      auto& s = samples_[k];
-      s.erase(std::remove_if(s.begin(), s.end(),
-                             [&](const Eigen::Vector3f& c) {
-                               const uint8_t current = lut_.classOf(
-                                   static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]), static_cast<uint8_t>(c[2]));
-                               const Eigen::Vector3d color = c.cast<double>();
-                               return claimedByOtherClass(color, current, static_cast<uint8_t>(k)) &&
-                                      (clusters_[current].mean() - color).norm() <
-                                          params_.zeta * clusters_[current].sigma();
-                             }),
-              s.end());
-    }
-  }
-  // Green (the carpet) and black (the own chassis) first: they are seen where expected whatever
-  // else is on the field, and the goals then leave out colors that are theirs (a robot in front of
-  // a goal, the carpet of a goal region under a wrong pose), also before the goal's first update.
-  constexpr int kUpdateOrder[kNumClasses - 1] = {kGreen, kBlack, kWhite, kYellow, kBlue};
-  for (const int k : kUpdateOrder) {
-    if (params_.robust_clusters && k != kGreen) {
-      if (k == kYellow || k == kBlue) dropColorsOfOtherClusters(samples_[k], static_cast<uint8_t>(k));
-      stats.cluster_samples[k] = clusters_[k].updateFromInliers(samples_[k], cluster_params);
-    } else {
-      stats.doublings += clusters_[k].update(samples_[k], cluster_params);
-      stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
-    }
+  // eq. 4, 5 and the doubling rule (2.2) for every class.
+  for (int k = 1; k < kNumClasses; ++k) {
+    stats.doublings += clusters_[k].update(samples_[k], cluster_params);
+    stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
   }
 
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.

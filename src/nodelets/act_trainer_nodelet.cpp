@@ -120,16 +120,18 @@ bool ActTrainerNodelet::configure(std::string* error) {
   params.white_filter = pnh_.param("white_filter", params.white_filter);
   params.seed = static_cast<uint32_t>(pnh_.param("seed", static_cast<int>(params.seed)));
   // Extensions beyond the paper (README, "The algorithm, and beyond the paper").
-  params.seed_clusters = pnh_.param("seed_clusters", params.seed_clusters);
   params.add_neighbourhood_cells = pnh_.param("add_neighbourhood_cells", params.add_neighbourhood_cells);
-  params.robust_clusters = pnh_.param("robust_clusters", params.robust_clusters);
   params.light_compensation = pnh_.param("light_compensation", params.light_compensation);
   params.light_change_add_stride = pnh_.param("light_change_add_stride", params.light_change_add_stride);
   params.removal_protect_cycles = pnh_.param("removal_protect_cycles", params.removal_protect_cycles);
   params.robots_train_black = pnh_.param("robots_train_black", params.robots_train_black);
   params.nearest_mean = pnh_.param("nearest_mean", params.nearest_mean);
   params.evidence_removal_ratio = pnh_.param("evidence_removal_ratio", params.evidence_removal_ratio);
-  params.reacquire_cycles = pnh_.param("reacquire_cycles", params.reacquire_cycles);
+  // Extensions removed because the randomized scene family showed they did not help (issue 11):
+  // a launch file that still sets them is told once instead of being ignored silently.
+  for (const char* removed : {"seed_clusters", "robust_clusters"}) {
+    if (pnh_.hasParam(removed)) NODELET_WARN("~%s is no longer a parameter (removed in issue 11); ignored", removed);
+  }
   try {
     params.validate();
   } catch (const std::exception& e) {

@@ -81,15 +81,12 @@ std::vector<EvalMode> evalModes(bool ablations) {
   std::vector<EvalMode> modes = {{"defaults", core::ActParams()}, {"paper", core::ActParams::paper()}};
   if (!ablations) return modes;
   const std::vector<std::pair<std::string, std::function<void(core::ActParams&)>>> off = {
-      {"seed_clusters", [](core::ActParams& p) { p.seed_clusters = false; }},
       {"add_neighbourhood_cells", [](core::ActParams& p) { p.add_neighbourhood_cells = 0; }},
-      {"robust_clusters", [](core::ActParams& p) { p.robust_clusters = false; }},
       {"light_compensation", [](core::ActParams& p) { p.light_compensation = false; }},
       {"removal_protect_cycles", [](core::ActParams& p) { p.removal_protect_cycles = 0; }},
       {"robots_train_black", [](core::ActParams& p) { p.robots_train_black = false; }},
       {"nearest_mean", [](core::ActParams& p) { p.nearest_mean = false; }},
       {"evidence_removal_ratio", [](core::ActParams& p) { p.evidence_removal_ratio = 0; }},
-      {"reacquire_cycles", [](core::ActParams& p) { p.reacquire_cycles = 0; }},
   };
   for (const auto& [name, apply] : off) {
     EvalMode m{"no_" + name, core::ActParams()};

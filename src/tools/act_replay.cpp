@@ -27,8 +27,6 @@ void printUsage(std::ostream& out) {
          "  --evidence-removal-ratio X  cells seen off the field X times as often as in it are removed (default 3, 0 "
          "off)\n"
          "  --no-nearest-mean    add colors to their class even when another class's mean is nearer\n"
-         "  --reacquire-cycles N a goal or black cluster whose colors stop fitting for n cycles is seeded again "
-         "(default 3)\n"
          "  --set NAME=VALUE     any ACT parameter by its name (as in ActParams and the nodelet's parameters)\n"
          "  --bootstrap-cycles N cycles on the first image with a pose (default 100)\n"
          "  --lut-every N        write /act/color_lut with every n-th frame (default 1)\n"
@@ -98,8 +96,6 @@ int main(int argc, char** argv) {
         p.removal_protect_cycles = integer();
       } else if (arg == "--evidence-removal-ratio") {
         p.evidence_removal_ratio = number();
-      } else if (arg == "--reacquire-cycles") {
-        p.reacquire_cycles = integer();
       } else if (arg == "--set") {
         const std::string item = value();
         const size_t eq = item.find('=');

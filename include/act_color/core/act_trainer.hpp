@@ -32,8 +32,6 @@ struct ActParams {
   bool white_filter = true;  // eq. 1
   uint32_t seed = 1;         // random start pixels
   // Extensions beyond the paper (0 / false gives the paper's algorithm exactly):
-  // the first update of a cluster takes its colors' own statistics (ClusterParams).
-  bool seed_clusters = true;
   // An added color also adds the cells within this many cells per channel around it whose
   // centres lie within zeta * sigma_k, unless they belong to a class whose cluster is nearer
   // (distance in sigmas). Sparse samples then cover a class's colors in a few cycles. Such a
@@ -41,11 +39,6 @@ struct ActParams {
   // removed when seen off the field, whatever its distance from the cluster (off-field colors
   // near a class, like a whitish hall floor, do not stay in the class by vicinity alone).
   int add_neighbourhood_cells = 1;
-  // Classes other than green learn only from colors that fit their cluster (ClassCluster::
-  // updateFromInliers), and a color that firmly belongs to another trained class (mapped to it and
-  // within zeta * sigma of it) trains neither cluster nor table for the expected class. Protects
-  // goals and black against robots in the goal region and wrong poses.
-  bool robust_clusters = true;
   // When the carpet's median color jumps beyond zeta * sigma of green (a global change of light or
   // of the camera's settings), the per-channel monotone map of colors estimated by LightModel
   // (quantiles of the carpet, line and chassis pixels before and after) moves every cluster and
@@ -74,10 +67,6 @@ struct ActParams {
   // in-field count is removed whatever its distance from the cluster: the color is more often
   // something else than the class (a spot-lit whitish hall floor next to white). 0: off.
   double evidence_removal_ratio = 3.0;
-  // Re-acquisition (ClusterParams::reacquire_cycles): a robust cluster whose expected colors fit it
-  // less than a quarter of the time for this many cycles in a row is seeded again from them, so no
-  // class stays lost after a change nothing foresaw. 0: off.
-  int reacquire_cycles = 3;
 
   void validate() const;
   // Sets the parameter `name` (as the field is named) from text; throws std::invalid_argument for
@@ -101,7 +90,6 @@ struct CycleStats {
   uint32_t doublings = 0;                               // sigma doublings over all clusters
   bool color_space_changed = false;                     // table reset for a new color space
   bool light_change = false;                            // light compensation applied
-  uint32_t reacquired = 0;                              // clusters seeded again (reacquire_cycles)
   Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain at the carpet's color
 };
 
@@ -141,11 +129,6 @@ class ActTrainer {
   // Uses the boundaries from prepareNearestMean(), made after this cycle's cluster update.
   bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
   void prepareNearestMean();
-  // Leaves out of k's cluster samples the colors within zeta * sigma of the green or the black
-  // cluster (the carpet, the chassis and robots; both updated first) and nearer to it than to k's
-  // (in sigmas; any such color while k is untrained). Not white: its sphere is wide under uneven
-  // light and would keep a lit goal from ever being seeded.
-  void dropColorsOfOtherClusters(std::vector<Eigen::Vector3f>& colors, uint8_t k) const;
   // True when the color is mapped to a trained class other than k and is nearer to that class's
   // cluster than to k's, in units of sigma.
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
