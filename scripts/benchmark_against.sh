@@ -44,3 +44,19 @@ mo=$(median "${o[@]}")
 echo "  $rev: ${b[*]} ms (median $mb)"
 echo "  this checkout: ${o[*]} ms (median $mo)"
 awk -v b="$mb" -v o="$mo" 'BEGIN {printf "  ratio (this / %s): %.2fx\n", "'"$rev"'", o / b}'
+# Instructions per ACT cycle under callgrind: repeatable whatever else the machine does.
+if command -v valgrind >/dev/null; then
+  cycles=200
+  for which in base ours; do
+    bin=$([ "$which" = base ] && echo "$base" || echo "$ours")
+    out=$(mktemp)
+    valgrind --tool=callgrind --callgrind-out-file="$out" --collect-atstart=no \
+      --toggle-collect='*runCallgrindCycles*' "$bin" --callgrind-cycles "$cycles" >/dev/null 2>&1
+    total=$(awk '/^summary:|^totals:/ {print $2; exit}' "$out")
+    rm -f "$out"
+    eval "ins_$which=$((total / cycles))"
+  done
+  # shellcheck disable=SC2154
+  awk -v b="$ins_base" -v o="$ins_ours" -v r="$rev" \
+    'BEGIN {printf "  callgrind: %d instructions per cycle (%s), %d (this checkout): %.3fx\n", b, r, o, o / b}'
+fi

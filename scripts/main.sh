@@ -6,7 +6,10 @@
 # Then it renders the scenario bags (sudden darkening, wrong pose, driving under changing light,
 # spotlights and shadows, sudden brightening), runs ACT and the segmentation over each with
 # act_replay, and prints per-class recall/precision and the cycles each class needed after every
-# light change; the same on a second camera. Installs what is missing and builds first.
+# light change; the same on a second camera. Last, ACT on a quick subset of the randomized scene
+# family's report split (act_eval: defaults, the paper's algorithm and the fixed-table ceiling side
+# by side; ACT_EVAL_SCENES, default 10, of the 100; the whole split: act_eval --split report).
+# Installs what is missing and builds first.
 #   scripts/main.sh            small scenarios (a few dozen frames each, about a minute)
 #   scripts/main.sh --full     full-length scenarios (hundreds of frames each)
 set -eo pipefail
@@ -65,3 +68,9 @@ for camera in msl_2007_580 msl_2007_640x480; do
   echo
   echo "act_color: labels, tables and per-frame CSVs in $scenarios/out, first frames as PNG in $scenarios/png"
 done
+
+# Scenes nobody tuned on: the randomized family's report split (issue 11), a quick subset.
+eval_scenes=${ACT_EVAL_SCENES:-10}
+echo
+echo "act_color: the randomized scene family, report split, first $eval_scenes of 100 scenes (act_eval)"
+rosrun act_color act_eval --split report --count "$eval_scenes" 2>/dev/null | sed 's/^/  /'

@@ -172,3 +172,29 @@ TEST(ActReplay, ClearErrorsForUnusableInput) {
                                         .c_str())),
             1);
 }
+
+// act_eval's command line: one family scene, its report on stdout; a family bag and calibration
+// from act_make_scenarios --family replay with act_replay like any other bag.
+TEST(ActEval, OneSceneReportAndFamilyBag) {
+  const std::string out = tempDir() + "/eval.txt";
+  const std::string eval = std::string(ACT_TOOLS_DIR) + "/act_eval";
+  ASSERT_EQ(std::system((eval + " --seeds 0-0 > " + out + " 2> /dev/null").c_str()), 0);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (const char* needle : {"seeds 0-0 (1 scenes", "defaults", "paper", "ceiling", "F1 below the paper"}) {
+    EXPECT_NE(text.find(needle), std::string::npos) << needle << " not in:\n" << text;
+  }
+  EXPECT_EQ(WEXITSTATUS(std::system((eval + " --split nonsense 2> /dev/null").c_str())), 2);
+  EXPECT_EQ(WEXITSTATUS(std::system((eval + " --set zeta=-1 2> /dev/null").c_str())), 2);
+
+  const std::string make = std::string(ACT_TOOLS_DIR) + "/act_make_scenarios --family 3 --length small --output-dir " +
+                           tempDir() + " > /dev/null";
+  ASSERT_EQ(std::system(make.c_str()), 0);
+  const std::string replay = std::string(ACT_TOOLS_DIR) + "/act_replay --bag " + tempDir() + "/family_3.bag" +
+                             " --calibration " + tempDir() + "/family_3.yaml --output " + tempDir() +
+                             "/family_3.out.bag --brief --no-progress > " + tempDir() + "/family_3.txt";
+  ASSERT_EQ(std::system(replay.c_str()), 0);
+  std::ifstream brief(tempDir() + "/family_3.txt");
+  const std::string summary((std::istreambuf_iterator<char>(brief)), std::istreambuf_iterator<char>());
+  EXPECT_NE(summary.find("green"), std::string::npos) << summary;
+}
