@@ -39,7 +39,7 @@ struct ActParams {
   // removed when seen off the field, whatever its distance from the cluster (off-field colors
   // near a class, like a whitish hall floor, do not stay in the class by vicinity alone).
   int add_neighbourhood_cells = 1;
-  // When the carpet's median color jumps beyond zeta * sigma of green (a global change of light or
+  // When the carpet's median color jumps beyond one sigma of green (a global change of light or
   // of the camera's settings), the per-channel monotone map of colors estimated by LightModel
   // (quantiles of the carpet, line and chassis pixels before and after) moves every cluster and
   // the table, so that all classes follow at once instead of re-learning from sparse samples.
@@ -132,7 +132,8 @@ class ActTrainer {
   // True when the color is mapped to a trained class other than k and is nearer to that class's
   // cluster than to k's, in units of sigma.
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
-  // The class a sample expected as k trains (robots_train_black re-routes green to black).
+  // The class a sample expected as k trains (robots_train_black re-routes green and goal colors
+  // of robots to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
   // Light compensation: the map moves every cluster and every table cell.
   void applyLightChange(const LightModel::Map& map);
@@ -173,7 +174,7 @@ class ActTrainer {
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
   std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> anchor_samples_;  // scratch of a denser look
-  std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, at most ~256
+  std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, about 192
   LightModel light_;
   std::vector<uint8_t> warped_;
   // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.
