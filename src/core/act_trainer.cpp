@@ -209,8 +209,11 @@ void ActTrainer::setParams(const ActParams& params) {
   params.validate();
   const bool bits_changed = params.lut_bits != params_.lut_bits;
   const bool seed_changed = params.seed != params_.seed;
+  // The light model's reference is not kept up while it is off: it starts afresh when turned on.
+  const bool light_on = params.light_compensation && !params_.light_compensation;
   params_ = params;
   if (seed_changed) rng_.seed(params_.seed);
+  if (light_on) light_.reset();
   if (bits_changed) {
     const bool known = space_known_;
     reset(lut_.colorSpace());
@@ -515,12 +518,14 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   });
   // The anchors of the light model (before any class filters its colors): carpet and lines from
   // the cluster samples, the chassis densely.
-  for (const uint32_t i : chassis_pixels_) {
-    uint8_t c[3];
-    image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
-    chassis_samples_.emplace_back(c[0], c[1], c[2]);
+  if (params_.light_compensation) {
+    for (const uint32_t i : chassis_pixels_) {
+      uint8_t c[3];
+      image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
+      chassis_samples_.emplace_back(c[0], c[1], c[2]);
+    }
+    light_.observe(samples_[kGreen], samples_[kWhite], chassis_samples_);
   }
-  light_.observe(samples_[kGreen], samples_[kWhite], chassis_samples_);
   const ClusterParams cluster_params = clusterParams();
   const ClassCluster& green = clusters_[kGreen];
   LightModel::Map light_map;
@@ -546,8 +551,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
   if (light_changed) {
     const Eigen::Vector3d from = light_.referenceGreenMedian();
-    const Eigen::Vector3d pivot =
-        lut_.colorSpace() == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d pivot = LightModel::pivot(lut_.colorSpace());
     for (int c = 0; c < 3; ++c) {
       const double d = from[c] - pivot[c];
       stats.light_gain[c] = static_cast<float>(std::abs(d) > 1e-6 ? (light_map.at(c, from[c]) - pivot[c]) / d : 1.0);
@@ -555,7 +559,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     applyLightChange(light_map);
     light_.rebase(light_map);
     stats.light_change = true;
-  } else {
+  } else if (params_.light_compensation) {
     light_.follow(params_.eta);
   }
   // eq. 4, 5 and the doubling rule (2.2) for every class.

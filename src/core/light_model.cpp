@@ -13,7 +13,6 @@ const std::array<std::vector<double>, 3> kLevels = {std::vector<double>{0.25, 0.
                                                     std::vector<double>{0.1, 0.3, 0.5, 0.7, 0.9},
                                                     std::vector<double>{0.25, 0.5, 0.75}};
 constexpr std::array<size_t, 3> kMinSamples = {8, 20, 6};
-constexpr int kGreenAnchor = 1;
 // Slopes of one channel's map between the anchor classes' medians may differ by this factor
 // (gamma 1.6 between chassis, carpet and lines: about 1.6; a carpet turned magenta: 19).
 constexpr double kMaxSlopeSpread = 4.0;
@@ -76,13 +75,12 @@ void LightModel::observe(const std::vector<Eigen::Vector3f>& green, const std::v
       }
     }
   }
-  observed_green_ = !current_.quantiles[kGreenAnchor].empty();
-  if (observed_green_) current_green_median_ = current_.quantiles[kGreenAnchor][2];
 }
 
 bool LightModel::estimate(ColorSpace space, Map* map) const {
-  if (!has_reference_ || !observed_green_ || reference_.quantiles[kGreenAnchor].empty()) return false;
-  const Eigen::Vector3d pivot = space == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
+  if (!has_reference_ || !observedGreen() || reference_.quantiles[kGreenAnchor].empty()) return false;
+  const Eigen::Vector3d& reference_green = referenceGreenMedian();
+  const Eigen::Vector3d pivot = LightModel::pivot(space);
   std::array<double, 3> channel_slope = {0.0, 0.0, 0.0};  // 0: no slope seen in the channel
   for (int c = 0; c < 3; ++c) {
     // Anchor points (before, after), and the anchor classes' medians for the slope check.
@@ -104,7 +102,7 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
       if (!clipped(cur[median][c]) && !clipped(ref[median][c])) medians.emplace_back(ref[median][c], cur[median][c]);
     }
     // One anchor class alone spans too little of the channel: a gain about the channel's zero.
-    if (classes < 2 && !points.empty() && std::abs(reference_green_median_[c] - pivot[c]) >= kMinAnchorDistance) {
+    if (classes < 2 && !points.empty() && std::abs(reference_green[c] - pivot[c]) >= kMinAnchorDistance) {
       points.emplace_back(pivot[c], pivot[c]);
     }
     std::sort(medians.begin(), medians.end());
@@ -147,8 +145,8 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
     for (const Block& b : blocks) knots.emplace_back(b.x / b.n, b.y / b.n);
     if (knots.size() < 2) {
       // One anchor: a gain about the channel's zero through it.
-      const double x = knots.empty() ? reference_green_median_[c] : knots[0].first;
-      const double y = knots.empty() ? current_green_median_[c] : knots[0].second;
+      const double x = knots.empty() ? reference_green[c] : knots[0].first;
+      const double y = knots.empty() ? greenMedian()[c] : knots[0].second;
       knots = {{pivot[c], pivot[c]}, {x, y}};
       if (std::abs(x - pivot[c]) < kMinAnchorDistance) knots = {{0.0, 0.0}, {255.0, 255.0}};
       std::sort(knots.begin(), knots.end());
@@ -192,7 +190,7 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
 }
 
 void LightModel::follow(double eta) {
-  if (!observed_green_) return;
+  if (!observedGreen()) return;
   for (int a = 0; a < kAnchorClasses; ++a) {
     const auto& cur = current_.quantiles[a];
     auto& ref = reference_.quantiles[a];
@@ -203,7 +201,6 @@ void LightModel::follow(double eta) {
     }
     for (size_t l = 0; l < cur.size(); ++l) ref[l] = (eta * ref[l] + cur[l]) / (eta + 1.0);
   }
-  reference_green_median_ = reference_.quantiles[kGreenAnchor][2];
   has_reference_ = true;
 }
 
@@ -217,7 +214,6 @@ void LightModel::rebase(const Map& map) {
       for (auto& q : ref) q = map.apply(q);
     }
   }
-  reference_green_median_ = reference_.quantiles[kGreenAnchor][2];
 }
 
 void LightModel::reset() { *this = LightModel(); }

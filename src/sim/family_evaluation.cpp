@@ -227,10 +227,10 @@ std::string formatReport(const FamilyReport& r) {
   char line[512];
   if (r.mode_names.empty()) return "no scenes\n";
   const size_t modes = r.mode_names.size();
-  auto dist = [](const Distribution& d, int precision = 2) {
+  auto dist = [](const Distribution& d) {
     char b[64];
     if (d.count == 0) return std::string("      -       ");
-    std::snprintf(b, sizeof(b), "%.*f %.*f %.*f", precision, d.median, precision, d.p10, precision, d.worst);
+    std::snprintf(b, sizeof(b), "%.2f %.2f %.2f", d.median, d.p10, d.worst);
     return std::string(b);
   };
   auto table = [&](const char* title, const std::vector<std::array<Distribution, core::kNumClasses>>& d,

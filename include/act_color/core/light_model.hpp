@@ -30,10 +30,14 @@ class LightModel {
   void observe(const std::vector<Eigen::Vector3f>& green, const std::vector<Eigen::Vector3f>& white,
                const std::vector<Eigen::Vector3f>& chassis);
   bool hasReference() const { return has_reference_; }
-  // The carpet's median color now and in the reference.
-  const Eigen::Vector3d& greenMedian() const { return current_green_median_; }
-  const Eigen::Vector3d& referenceGreenMedian() const { return reference_green_median_; }
-  bool observedGreen() const { return observed_green_; }
+  bool observedGreen() const { return !current_.quantiles[kGreenAnchor].empty(); }
+  // The carpet's median color now (observedGreen()) and in the reference (hasReference()).
+  const Eigen::Vector3d& greenMedian() const { return current_.quantiles[kGreenAnchor][kMedianLevel]; }
+  const Eigen::Vector3d& referenceGreenMedian() const { return reference_.quantiles[kGreenAnchor][kMedianLevel]; }
+  // The value about which a gain scales a channel: 0, or 128 for the chroma channels of YUV.
+  static Eigen::Vector3d pivot(ColorSpace space) {
+    return space == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
+  }
 
   // The map from the reference to this cycle's anchors. False when the anchors do not describe a
   // global change of light: fewer than two anchors per channel, or slopes further apart (within a
@@ -51,14 +55,13 @@ class LightModel {
  private:
   // Per anchor class (0 chassis, 1 carpet, 2 lines), quantile levels of each.
   static constexpr int kAnchorClasses = 3;
+  static constexpr int kGreenAnchor = 1;  // the carpet's quantiles: 10, 30, 50, 70, 90%
+  static constexpr int kMedianLevel = 2;  // the carpet's 50%
   struct Anchors {
     std::array<std::vector<Eigen::Vector3d>, kAnchorClasses> quantiles;  // empty: not seen
   };
   Anchors current_, reference_;
   bool has_reference_ = false;
-  bool observed_green_ = false;
-  Eigen::Vector3d current_green_median_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d reference_green_median_ = Eigen::Vector3d::Zero();
   std::array<uint32_t, 256> histogram_{};  // scratch
 };
 
