@@ -76,15 +76,26 @@ class LightRecovery : public ::testing::Test {
     return settle + 1;
   }
 
-  static void expectRecovers(const sim::ToneCurve& curve, const std::string& name) {
-    const auto after = run(curve, core::ActParams());
-    for (int k : core::trainableClasses()) {
-      double final_recall = 0;
-      const int cycles = settleCycles(after, k, &final_recall);
-      std::printf("%s: %s final recall %.3f, settled in %d cycles\n", name.c_str(), core::className(k), final_recall,
-                  cycles);
-      EXPECT_GT(final_recall, 0.8) << name << ": " << core::className(k) << " is lost";
-      EXPECT_LE(cycles, k == core::kGreen || k == core::kWhite ? 2 : 12) << name << ": " << core::className(k);
+  // Green and white with several seeds of the trainer's random sample positions: a recovery that
+  // holds by the luck of one seed is not one (a warm white balance was missed with 7 of 10 seeds
+  // once). The goals and black with the first seed only: black's recall swings by 0.03 from frame
+  // to frame with some seeds (a dark cell of the robots leaves and rejoins the table), which the
+  // 0.02 settle tolerance reads as not settled (issue 11 left open on it).
+  static void expectRecovers(const sim::ToneCurve& curve, const std::string& name, int seeds = 5) {
+    for (int seed = 1; seed <= seeds; ++seed) {
+      core::ActParams params;
+      params.seed = static_cast<uint32_t>(seed);
+      const auto after = run(curve, params);
+      for (int k : core::trainableClasses()) {
+        if (seed > 1 && k != core::kGreen && k != core::kWhite) continue;
+        double final_recall = 0;
+        const int cycles = settleCycles(after, k, &final_recall);
+        std::printf("%s, seed %d: %s final recall %.3f, settled in %d cycles\n", name.c_str(), seed,
+                    core::className(k), final_recall, cycles);
+        EXPECT_GT(final_recall, 0.8) << name << ", seed " << seed << ": " << core::className(k) << " is lost";
+        EXPECT_LE(cycles, k == core::kGreen || k == core::kWhite ? 2 : 12)
+            << name << ", seed " << seed << ": " << core::className(k);
+      }
     }
   }
 
@@ -115,7 +126,7 @@ TEST_F(LightRecovery, AnyRandomMonotoneTransfer) {
   for (int n = 0; n < 10; ++n) {
     std::string description;
     const sim::ToneCurve curve = sim::ToneCurve::random(rng, 1.0, &description);
-    expectRecovers(curve, "random " + std::to_string(n) + " (" + description + ")");
+    expectRecovers(curve, "random " + std::to_string(n) + " (" + description + ")", 2);
   }
 }
 
