@@ -139,7 +139,7 @@ FieldCalibration parseField(MapReader field) {
   f.line_width_m = field.real("line_width_m", 0.0, 10.0, true);
   f.margin_m = field.real("margin_m", 0.0, 100.0);
   f.center_circle_radius_m = field.real("center_circle_radius_m", 0.0, 1000.0, true);
-  f.corner_arc_radius_m = field.real("corner_arc_radius_m", 0.0, 1000.0, true);
+  f.corner_arc_radius_m = field.real("corner_arc_radius_m", 0.0, 1000.0);  // 0: no corner arcs
   {
     MapReader goal_area = field.map("goal_area");
     f.goal_area_depth_m = goal_area.real("depth_m", 0.0, 1000.0, true);
@@ -154,11 +154,18 @@ FieldCalibration parseField(MapReader field) {
   }
   if (field.has("penalty_mark_distance_m"))
     f.penalty_mark_distance_m = field.real("penalty_mark_distance_m", 0.0, 1000.0, true);
+  if (field.has("penalty_arc")) {
+    MapReader arc = field.map("penalty_arc");
+    f.penalty_arc_radius_m = arc.real("radius_m", 0.0, 1000.0, true);
+    f.penalty_arc_center_m = arc.real("center_distance_m", 0.0, 1000.0);
+    arc.rejectUnknownKeys();
+  }
   {
     MapReader goal = field.map("goal");
     f.goal_width_m = goal.real("width_m", 0.0, 1000.0, true);
     f.goal_height_m = goal.real("height_m", 0.0, 100.0, true);
     f.goal_depth_m = goal.real("depth_m", 0.0, 100.0, true);
+    if (goal.has("setback_m")) f.goal_setback_m = goal.real("setback_m", 0.0, 100.0);
     goal.rejectUnknownKeys();
   }
   f.yellow_goal_x_sign = field.sign("yellow_goal_x_sign");
@@ -245,7 +252,15 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
   if (f.penalty_mark_distance_m && !(*f.penalty_mark_distance_m < f.length_m / 2)) {
     fail(source, "field.penalty_mark_distance_m", "must be less than half the length");
   }
+  if (f.penalty_arc_radius_m) {
+    if (!(f.penalty_arc_center_m < f.length_m / 2))
+      fail(source, "field.penalty_arc.center_distance_m", "must be less than half the length");
+    if (!(f.penalty_arc_center_m - *f.penalty_arc_radius_m < f.penalty_area_depth_m))
+      fail(source, "field.penalty_arc.radius_m", "the arc must reach out of the penalty area");
+    if (!(*f.penalty_arc_radius_m < f.width_m / 2)) fail(source, "field.penalty_arc.radius_m", "must fit into the field");
+  }
   if (!(f.goal_width_m < f.width_m)) fail(source, "field.goal.width_m", "must be less than field.width_m");
+  if (!(f.goal_setback_m <= f.margin_m)) fail(source, "field.goal.setback_m", "must lie within field.margin_m");
   if (f.yellow_goal_x_sign != 1 && f.yellow_goal_x_sign != -1)
     fail(source, "field.yellow_goal_x_sign", "must be 1 or -1");
 }
@@ -276,8 +291,13 @@ std::string toYaml(const Calibration& calibration) {
     << "  goal_area: {depth_m: " << f.goal_area_depth_m << ", width_m: " << f.goal_area_width_m << "}\n"
     << "  penalty_area: {depth_m: " << f.penalty_area_depth_m << ", width_m: " << f.penalty_area_width_m << "}\n";
   if (f.penalty_mark_distance_m) s << "  penalty_mark_distance_m: " << *f.penalty_mark_distance_m << "\n";
-  s << "  goal: {width_m: " << f.goal_width_m << ", height_m: " << f.goal_height_m << ", depth_m: " << f.goal_depth_m
-    << "}\n"
+  if (f.penalty_arc_radius_m) {
+    s << "  penalty_arc: {radius_m: " << *f.penalty_arc_radius_m << ", center_distance_m: " << f.penalty_arc_center_m
+      << "}\n";
+  }
+  s << "  goal: {width_m: " << f.goal_width_m << ", height_m: " << f.goal_height_m << ", depth_m: " << f.goal_depth_m;
+  if (f.goal_setback_m > 0) s << ", setback_m: " << f.goal_setback_m;
+  s << "}\n"
     << "  yellow_goal_x_sign: " << f.yellow_goal_x_sign << "\n";
   return s.str();
 }

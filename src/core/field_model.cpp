@@ -62,8 +62,8 @@ FieldModel::FieldModel(const FieldCalibration& field)
   // Goals stand behind the goal lines' outer edges; index 0 is yellow, 1 blue.
   for (int i = 0; i < 2; ++i) {
     const double sign = (i == 0 ? 1.0 : -1.0) * field.yellow_goal_x_sign;
-    const double x_near = sign * half_length_m_;
-    const double x_far = sign * (half_length_m_ + field.goal_depth_m);
+    const double x_near = sign * (half_length_m_ + field.goal_setback_m);
+    const double x_far = sign * (half_length_m_ + field.goal_setback_m + field.goal_depth_m);
     goal_min_[i] = Eigen::Vector3d(std::min(x_near, x_far), -field.goal_width_m / 2, 0.0);
     goal_max_[i] = Eigen::Vector3d(std::max(x_near, x_far), field.goal_width_m / 2, field.goal_height_m);
   }
@@ -103,6 +103,11 @@ bool FieldModel::lineMayCross(double x0, double x1, double y0, double y1) const 
     const double mark = hl - *field_.penalty_mark_distance_m;
     if (annulusMeets(x0 - mark, x1 - mark, y0, y1, -1.0, lw / 2)) return true;
   }
+  if (field_.penalty_arc_radius_m && x0 < hl - field_.penalty_area_depth_m) {
+    const double centre = hl - field_.penalty_arc_center_m;
+    const double r = *field_.penalty_arc_radius_m;
+    if (annulusMeets(x0 - centre, x1 - centre, y0, y1, r - lw, r)) return true;
+  }
   return false;
 }
 
@@ -132,6 +137,11 @@ bool FieldModel::isLineUncached(double x_m, double y_m) const {
   if (hypotWithin(hl - ax, hw - ay, field_.corner_arc_radius_m - lw, field_.corner_arc_radius_m)) return true;
   if (field_.penalty_mark_distance_m) {
     if (hypotAtMost(ax - (hl - *field_.penalty_mark_distance_m), y_m, lw / 2)) return true;
+  }
+  // The penalty arc, outside the penalty area only.
+  if (field_.penalty_arc_radius_m && ax < hl - field_.penalty_area_depth_m) {
+    const double r = *field_.penalty_arc_radius_m;
+    if (hypotWithin(ax - (hl - field_.penalty_arc_center_m), y_m, r - lw, r)) return true;
   }
   return false;
 }

@@ -141,3 +141,49 @@ TEST(Calibration, YamlRoundTrip) {
   EXPECT_EQ(c.camera.elevation_map, d.camera.elevation_map);
   EXPECT_EQ(c.field.penalty_mark_distance_m, d.field.penalty_mark_distance_m);
 }
+
+// Issue 12: lab fields. Penalty arcs and goals set back from the line (colored panels) are optional
+// keys; a field without corner arcs has corner_arc_radius_m 0; unknown keys stay errors.
+TEST(Calibration, LabFieldKeysAreOptionalAndRoundTrip) {
+  const std::string lab = replaced(replaced(replaced(contractText(), "  penalty_mark_distance_m: 3.0",
+                                                     "  penalty_arc: {radius_m: 1.5, center_distance_m: 2.25}"),
+                                            "depth_m: 0.5}", "depth_m: 0.02, setback_m: 0.3}"),
+                                   "corner_arc_radius_m: 0.75", "corner_arc_radius_m: 0");
+  const auto c = parseCalibration(lab, "lab.yaml");
+  ASSERT_TRUE(c.field.penalty_arc_radius_m.has_value());
+  EXPECT_DOUBLE_EQ(*c.field.penalty_arc_radius_m, 1.5);
+  EXPECT_DOUBLE_EQ(c.field.penalty_arc_center_m, 2.25);
+  EXPECT_DOUBLE_EQ(c.field.goal_setback_m, 0.3);
+  EXPECT_DOUBLE_EQ(c.field.goal_depth_m, 0.02);
+  EXPECT_DOUBLE_EQ(c.field.corner_arc_radius_m, 0.0);
+  const auto d = parseCalibration(act_color::core::toYaml(c), "roundtrip");
+  EXPECT_EQ(act_color::core::toYaml(c), act_color::core::toYaml(d));
+  EXPECT_EQ(d.field.penalty_arc_radius_m, c.field.penalty_arc_radius_m);
+  EXPECT_DOUBLE_EQ(d.field.goal_setback_m, 0.3);
+  // Without the keys: no arc, the goal at the line.
+  const auto plain = act_color::test::contractCalibration();
+  EXPECT_FALSE(plain.field.penalty_arc_radius_m.has_value());
+  EXPECT_DOUBLE_EQ(plain.field.goal_setback_m, 0.0);
+  EXPECT_EQ(act_color::core::toYaml(plain).find("penalty_arc"), std::string::npos);
+  EXPECT_EQ(act_color::core::toYaml(plain).find("setback_m"), std::string::npos);
+}
+
+TEST(Calibration, LabFieldKeysAreChecked) {
+  const std::string text = contractText();
+  auto arc = [&](const std::string& value) {
+    return errorOf(replaced(text, "  penalty_mark_distance_m: 3.0", "  penalty_arc: " + value));
+  };
+  EXPECT_EQ(arc("{radius_m: 1.5, center_distance_m: 2.25}"), "");
+  EXPECT_NE(arc("{radius_m: 1.5}").find("field.penalty_arc.center_distance_m"), std::string::npos);
+  EXPECT_NE(arc("{radius_m: 1.5, center_distance_m: 2.25, colour: 1}").find("field.penalty_arc.colour"),
+            std::string::npos);
+  EXPECT_NE(arc("{radius_m: 0, center_distance_m: 2.25}").find("field.penalty_arc.radius_m"), std::string::npos);
+  // An arc that stays inside the penalty area (2.25 m deep) would never be drawn.
+  EXPECT_NE(arc("{radius_m: 0.5, center_distance_m: 3.0}").find("reach out of the penalty area"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(text, "depth_m: 0.5}", "depth_m: 0.5, setback_m: 1.5}")).find("field.goal.setback_m"),
+            std::string::npos);  // beyond the 1 m margin
+  EXPECT_NE(errorOf(replaced(text, "corner_arc_radius_m: 0.75", "corner_arc_radius_m: -0.1"))
+                .find("field.corner_arc_radius_m"),
+            std::string::npos);
+}

@@ -105,6 +105,27 @@ TEST(FieldModel, LineGridNeverHidesALine) {
   wide.corner_arc_radius_m = 0.0;
   wide.penalty_mark_distance_m.reset();
   fields.push_back(wide);
+  // A lab field with penalty arcs (issue 12): a semicircle on the area's front line, and one whose
+  // centre lies inside the area.
+  auto lab = fields.front();
+  lab.length_m = 6.0;
+  lab.width_m = 4.0;
+  lab.line_width_m = 0.05;
+  lab.center_circle_radius_m = 0.6;
+  lab.corner_arc_radius_m = 0.0;
+  lab.goal_area_depth_m = 0.25;
+  lab.goal_area_width_m = 1.2;
+  lab.penalty_area_depth_m = 0.5;
+  lab.penalty_area_width_m = 2.0;
+  lab.penalty_mark_distance_m.reset();
+  lab.penalty_arc_radius_m = 0.4;
+  lab.penalty_arc_center_m = 0.5;
+  lab.goal_width_m = 1.0;
+  fields.push_back(lab);
+  auto fifa_like = fields.front();
+  fifa_like.penalty_arc_radius_m = 1.7;
+  fifa_like.penalty_arc_center_m = 1.9;
+  fields.push_back(fifa_like);
   std::mt19937 rng(7);
   for (const auto& calibration : fields) {
     const FieldModel f(calibration);
@@ -130,4 +151,40 @@ TEST(FieldModel, LineGridNeverHidesALine) {
     EXPECT_GT(f.lineFreeFraction(), 0.5);  // and it answers most of the field
   }
   EXPECT_FALSE(FieldModel(fields.front()).isLine(std::nan(""), 0.0));
+}
+
+TEST(FieldModel, PenaltyArcsAreDrawnOutsideThePenaltyAreaOnly) {
+  auto cal = act_color::test::contractCalibration().field;  // 18 x 12 m, penalty area 2.25 deep
+  cal.penalty_mark_distance_m.reset();
+  const FieldModel plain(cal);
+  cal.penalty_arc_radius_m = 1.5;
+  cal.penalty_arc_center_m = 2.25;  // on the area's front line: a semicircle towards the centre
+  const FieldModel f(cal);
+  const double front = 9.0 - 2.25;  // the area's front line (outer edge)
+  for (const double sign : {1.0, -1.0}) {
+    // The arc's apex on the long axis, and a point at 45 degrees, on both halves.
+    const double apex = sign * (front - 1.5 + cal.line_width_m / 2);
+    EXPECT_TRUE(f.isLine(apex, 0.0));
+    EXPECT_FALSE(plain.isLine(apex, 0.0));
+    const double r = 1.5 - cal.line_width_m / 2;
+    EXPECT_TRUE(f.isLine(sign * (front - r * std::cos(M_PI / 4)), r * std::sin(M_PI / 4)));
+    // The same circle inside the area is not drawn; nor is the arc's inside or outside.
+    EXPECT_FALSE(f.isLine(sign * (front + r * std::cos(M_PI / 4)), r * std::sin(M_PI / 4)));
+    EXPECT_FALSE(f.isLine(sign * (front - 1.0), 0.0));
+    EXPECT_FALSE(f.isLine(sign * (front - 1.8), 0.0));
+  }
+}
+
+TEST(FieldModel, AGoalSetBackStandsBehindTheLine) {
+  auto cal = act_color::test::contractCalibration().field;
+  cal.goal_depth_m = 0.02;  // a colored panel
+  cal.goal_setback_m = 0.3;
+  const FieldModel f(cal);
+  Eigen::Vector3d lo, hi;
+  f.goalBox(kYellow, &lo, &hi);
+  EXPECT_NEAR(lo.x(), 9.3, 1e-12);
+  EXPECT_NEAR(hi.x(), 9.32, 1e-12);
+  f.goalBox(kBlue, &lo, &hi);
+  EXPECT_NEAR(lo.x(), -9.32, 1e-12);
+  EXPECT_NEAR(hi.x(), -9.3, 1e-12);
 }

@@ -37,9 +37,15 @@ struct FieldCalibration {
   double penalty_area_depth_m = 0.0;
   double penalty_area_width_m = 0.0;
   std::optional<double> penalty_mark_distance_m;
+  // Optional penalty arc, as lab fields draw it: a circle of this radius (outer edge) centred on
+  // the long axis at penalty_arc_center_m from the goal line's outer edge, drawn only outside the
+  // penalty area (with the centre on the area's front line: a semicircle).
+  std::optional<double> penalty_arc_radius_m;
+  double penalty_arc_center_m = 0.0;
   double goal_width_m = 0.0;
   double goal_height_m = 0.0;
-  double goal_depth_m = 0.0;
+  double goal_depth_m = 0.0;  // a colored panel is a goal of small depth
+  double goal_setback_m = 0.0;  // optional: gap between the goal line's outer edge and the goal
   int yellow_goal_x_sign = 1;
 };
 

@@ -11,8 +11,9 @@
 namespace act_color {
 namespace core {
 
-// The static world of a 2007-rules MSL field in the `field` frame: carpet, lines and marks, the
-// green margin and the two goals as solid colored boxes behind the goal lines.
+// The static world of a 2007-rules MSL field in the `field` frame: carpet, lines and marks (and the
+// penalty arcs of lab fields), the green margin and the two goals as solid colored boxes behind
+// the goal lines (a colored panel: a box of small depth, optionally set back from the line).
 class FieldModel {
  public:
   explicit FieldModel(const FieldCalibration& field);
