@@ -4,6 +4,7 @@
 #include <fstream>
 #include <iomanip>
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -128,8 +129,33 @@ CameraCalibration parseCamera(MapReader camera) {
     const auto pair = numberSequence(camera, map[static_cast<int>(i)], entry_key, 2);
     c.elevation_map.emplace_back(pair[0], pair[1]);
   }
+  if (camera.has("self_mask")) {
+    const cv::FileNode n = camera.child("self_mask");
+    if (!n.isString() || static_cast<std::string>(n).empty() ||
+        static_cast<std::string>(n).find_first_of("\"\\\n") != std::string::npos)
+      fail(camera.source(), camera.key("self_mask"), "must be the file name of a PNG (no quotes or backslashes)");
+    c.self_mask_file = static_cast<std::string>(n);
+  }
   camera.rejectUnknownKeys();
   return c;
+}
+
+// The self mask's pixels from its PNG, `file` relative to the calibration's directory.
+void readSelfMask(CameraCalibration& c, const std::string& source) {
+  std::string path = c.self_mask_file;
+  const size_t slash = source.rfind('/');
+  if (!path.empty() && path[0] != '/' && slash != std::string::npos) path = source.substr(0, slash + 1) + path;
+  const cv::Mat mask = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (mask.empty()) fail(source, "camera.self_mask", "cannot read the image '" + path + "'");
+  if (mask.cols != c.width || mask.rows != c.height) {
+    fail(source, "camera.self_mask",
+         "'" + path + "' is " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) + " px, the camera is " +
+             std::to_string(c.width) + "x" + std::to_string(c.height));
+  }
+  c.self_mask.assign(static_cast<size_t>(c.width) * c.height, 0);
+  for (int v = 0; v < mask.rows; ++v) {
+    for (int u = 0; u < mask.cols; ++u) c.self_mask[static_cast<size_t>(v) * c.width + u] = mask.at<uint8_t>(v, u) != 0;
+  }
 }
 
 FieldCalibration parseField(MapReader field) {
@@ -201,6 +227,7 @@ Calibration parseCalibration(const std::string& yaml_text, const std::string& so
   calibration.field = parseField(root.map("field"));
   root.rejectUnknownKeys();
   validateCalibration(calibration, source_name);
+  if (!calibration.camera.self_mask_file.empty()) readSelfMask(calibration.camera, source_name);
   return calibration;
 }
 
@@ -257,7 +284,8 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
       fail(source, "field.penalty_arc.center_distance_m", "must be less than half the length");
     if (!(f.penalty_arc_center_m - *f.penalty_arc_radius_m < f.penalty_area_depth_m))
       fail(source, "field.penalty_arc.radius_m", "the arc must reach out of the penalty area");
-    if (!(*f.penalty_arc_radius_m < f.width_m / 2)) fail(source, "field.penalty_arc.radius_m", "must fit into the field");
+    if (!(*f.penalty_arc_radius_m < f.width_m / 2))
+      fail(source, "field.penalty_arc.radius_m", "must fit into the field");
   }
   if (!(f.goal_width_m < f.width_m)) fail(source, "field.goal.width_m", "must be less than field.width_m");
   if (!(f.goal_setback_m <= f.margin_m)) fail(source, "field.goal.setback_m", "must lie within field.margin_m");
@@ -281,6 +309,7 @@ std::string toYaml(const Calibration& calibration) {
     << "  mirror_radius_px: " << c.mirror_radius_px << "\n"
     << "  elevation_map:\n";
   for (const auto& [r, e] : c.elevation_map) s << "    - [" << r << ", " << e << "]\n";
+  if (!c.self_mask_file.empty()) s << "  self_mask: \"" << c.self_mask_file << "\"\n";
   s << "field:\n"
     << "  length_m: " << f.length_m << "\n"
     << "  width_m: " << f.width_m << "\n"
@@ -300,6 +329,23 @@ std::string toYaml(const Calibration& calibration) {
   s << "}\n"
     << "  yellow_goal_x_sign: " << f.yellow_goal_x_sign << "\n";
   return s.str();
+}
+
+void saveSelfMask(const CameraCalibration& camera, const std::string& path) {
+  if (camera.self_mask.size() != static_cast<size_t>(camera.width) * camera.height)
+    throw CalibrationError(path + ": the self mask does not match the camera's size");
+  cv::Mat image(camera.height, camera.width, CV_8UC1);
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u)
+      image.at<uint8_t>(v, u) = camera.self_mask[static_cast<size_t>(v) * camera.width + u] ? 255 : 0;
+  }
+  bool written = false;
+  try {
+    written = cv::imwrite(path, image);
+  } catch (const cv::Exception&) {
+    written = false;
+  }
+  if (!written) throw CalibrationError(path + ": cannot write the self mask");
 }
 
 }  // namespace core

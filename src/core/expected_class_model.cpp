@@ -15,7 +15,8 @@ ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
     const PixelRay& ray = camera_.ray(i);
     ground_range_m_[i] = ray.region == PixelRegion::kFloor ? std::hypot(ray.ground_x_m, ray.ground_y_m)
                                                            : std::numeric_limits<float>::infinity();
-    const bool never_unknown = ray.region == PixelRegion::kNotImaged || ray.region == PixelRegion::kChassis;
+    const bool never_unknown = ray.region == PixelRegion::kNotImaged || ray.region == PixelRegion::kChassis ||
+                               ray.region == PixelRegion::kSelf;
     removal_range_m_[i] = never_unknown ? -std::numeric_limits<float>::infinity() : ground_range_m_[i];
   }
 }
@@ -53,6 +54,7 @@ uint8_t ExpectedClassModel::geometricClass(size_t pixel_index, const PoseTransfo
   const PixelRay& ray = camera_.ray(pixel_index);
   switch (ray.region) {
     case PixelRegion::kNotImaged:
+    case PixelRegion::kSelf:
       return kNotImaged;
     case PixelRegion::kChassis:
       return kBlack;

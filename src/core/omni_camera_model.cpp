@@ -11,6 +11,13 @@ OmniCameraModel::OmniCameraModel(const CameraCalibration& camera) : camera_(came
   for (int v = 0; v < camera_.height; ++v) {
     for (int u = 0; u < camera_.width; ++u) rays_[static_cast<size_t>(v) * camera_.width + u] = computeRay(u, v);
   }
+  // Pixels of the self mask show the own robot (struts, cables): their view rays are kept, their
+  // region says they show no class.
+  if (camera_.self_mask.size() == rays_.size()) {
+    for (size_t i = 0; i < rays_.size(); ++i) {
+      if (camera_.self_mask[i] && rays_[i].region != PixelRegion::kNotImaged) rays_[i].region = PixelRegion::kSelf;
+    }
+  }
 }
 
 double OmniCameraModel::elevationAtRadius(double r_px) const {

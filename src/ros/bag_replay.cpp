@@ -11,12 +11,15 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <vector>
 
+#include "act_color/core/omni_camera_model.hpp"
 #include "act_color/core/segmenter.hpp"
+#include "act_color/core/self_mask_learner.hpp"
 #include "act_color/ros/conversions.hpp"
 
 namespace act_color {
@@ -130,6 +133,8 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
 
   core::ActTrainer trainer(calibration, options.params);
   const core::Segmenter segmenter(calibration.camera);
+  std::unique_ptr<core::SelfMaskLearner> self_mask;
+  if (!options.self_mask_png.empty()) self_mask = std::make_unique<core::SelfMaskLearner>(calibration);
   ReplayResult result;
   result.evaluation = core::RunEvaluation(options.adapt_frames);
   cv::Mat labels(calibration.camera.height, calibration.camera.width, CV_8UC1);
@@ -170,6 +175,7 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
         }
         trainer.cycle(view, pose->pose);
         ++result.trained;
+        if (self_mask) self_mask->add(view, pose->pose, trainer.lut());
       } else {
         ++result.without_pose;
       }
@@ -203,6 +209,25 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
     }
   }
   out.close();
+  if (self_mask) {
+    core::CameraCalibration camera = calibration.camera;
+    camera.self_mask = self_mask->mask();
+    if (camera.self_mask.empty()) throw ReplayError("no frame with a pose: no self mask learned");
+    try {
+      core::saveSelfMask(camera, options.self_mask_png);
+    } catch (const core::CalibrationError& e) {
+      throw ReplayError(e.what());
+    }
+    const core::OmniCameraModel model(calibration.camera);
+    size_t imaged = 0, masked = 0;
+    for (size_t i = 0; i < camera.self_mask.size(); ++i) {
+      if (model.ray(i).region == core::PixelRegion::kNotImaged) continue;
+      ++imaged;
+      masked += camera.self_mask[i];
+    }
+    result.self_mask_poses = self_mask->frames();
+    result.self_mask_fraction = imaged ? static_cast<double>(masked) / imaged : 0.0;
+  }
   if (!options.csv_path.empty()) {
     std::ofstream csv(options.csv_path);
     if (!csv) throw ReplayError(options.csv_path + ": cannot be written");

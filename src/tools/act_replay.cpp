@@ -3,6 +3,7 @@
 #include <ros/time.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <string>
@@ -32,6 +33,7 @@ void printUsage(std::ostream& out) {
          "  --lut-every N        write /act/color_lut with every n-th frame (default 1)\n"
          "  --adapt-frames N     frames after each event left out of the *_ad figures (default 12)\n"
          "  --csv FILE           per-frame recall and precision per class\n"
+         "  --learn-self-mask F  learn the own robot's pixels (struts, cables) and write them to the PNG F\n"
          "  --png DIR            input | classified | truth as PNG for every n-th frame (--png-every N, 10)\n"
          "  --no-progress        no progress lines on stderr\n"
          "  --brief              a short accuracy summary instead of the full report\n";
@@ -115,6 +117,8 @@ int main(int argc, char** argv) {
         options.png_dir = value();
       } else if (arg == "--png-every") {
         options.png_every = std::max<size_t>(1, std::stoul(value()));
+      } else if (arg == "--learn-self-mask") {
+        options.self_mask_png = value();
       } else if (arg == "--brief") {
         brief = true;
       } else if (arg == "--no-progress") {
@@ -138,6 +142,12 @@ int main(int argc, char** argv) {
     std::cout << "act_replay: " << result.images << " frames from " << options.input_bag << " (" << result.trained
               << " trained, " << result.without_pose << " without a usable pose, " << result.unusable_images
               << " unusable images, " << result.with_truth << " with truth); wrote " << options.output_bag << "\n";
+    if (!options.self_mask_png.empty()) {
+      std::printf(
+          "act_replay: self mask learned from %d poses: %.2f%% of the imaged pixels; wrote %s (set camera.self_mask "
+          "to it)\n",
+          result.self_mask_poses, 100.0 * result.self_mask_fraction, options.self_mask_png.c_str());
+    }
     if (result.with_truth > 0) std::cout << (brief ? result.evaluation.brief() : result.evaluation.report());
     return result.images > result.unusable_images ? 0 : 1;
   } catch (const std::exception& e) {

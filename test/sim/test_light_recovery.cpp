@@ -90,8 +90,8 @@ class LightRecovery : public ::testing::Test {
         if (seed > 1 && k != core::kGreen && k != core::kWhite) continue;
         double final_recall = 0;
         const int cycles = settleCycles(after, k, &final_recall);
-        std::printf("%s, seed %d: %s final recall %.3f, settled in %d cycles\n", name.c_str(), seed,
-                    core::className(k), final_recall, cycles);
+        std::printf("%s, seed %d: %s final recall %.3f, settled in %d cycles\n", name.c_str(), seed, core::className(k),
+                    final_recall, cycles);
         EXPECT_GT(final_recall, 0.8) << name << ", seed " << seed << ": " << core::className(k) << " is lost";
         EXPECT_LE(cycles, k == core::kGreen || k == core::kWhite ? 2 : 12)
             << name << ", seed " << seed << ": " << core::className(k);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,11 @@ struct CameraCalibration {
   double mirror_radius_px = 0.0;
   // (r_px, elevation_rad), both strictly increasing.
   std::vector<std::pair<double, double>> elevation_map;
+  // Optional: pixels that show the own robot wherever it stands (mirror struts, a cable), row-major,
+  // 1 = own robot; empty = none. Read from the PNG `self_mask_file` names (key camera.self_mask,
+  // relative to the calibration file); nonzero pixels of the PNG are the mask.
+  std::string self_mask_file;
+  std::vector<uint8_t> self_mask;
 };
 
 // 2007-rules MSL field geometry. Lengths to the outer edges of lines.
@@ -44,7 +50,7 @@ struct FieldCalibration {
   double penalty_arc_center_m = 0.0;
   double goal_width_m = 0.0;
   double goal_height_m = 0.0;
-  double goal_depth_m = 0.0;  // a colored panel is a goal of small depth
+  double goal_depth_m = 0.0;    // a colored panel is a goal of small depth
   double goal_setback_m = 0.0;  // optional: gap between the goal line's outer edge and the goal
   int yellow_goal_x_sign = 1;
 };
@@ -68,8 +74,12 @@ Calibration loadCalibration(const std::string& path);
 Calibration parseCalibration(const std::string& yaml_text, const std::string& source_name);
 // Checks ranges and consistency of an already filled calibration; throws CalibrationError.
 void validateCalibration(const Calibration& calibration, const std::string& source_name);
-// YAML text in the contract's format; parseCalibration(toYaml(c)) == c.
+// YAML text in the contract's format; parseCalibration(toYaml(c)) == c (the self mask's file name
+// is written, its pixels are saved with saveSelfMask).
 std::string toYaml(const Calibration& calibration);
+// Writes camera.self_mask as a PNG (255 = own robot) to `path`; throws CalibrationError when it
+// cannot. The file `self_mask_file` names is resolved against the calibration file's directory.
+void saveSelfMask(const CameraCalibration& camera, const std::string& path);
 
 }  // namespace core
 }  // namespace act_color

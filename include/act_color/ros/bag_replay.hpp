@@ -27,6 +27,9 @@ struct ReplayOptions {
   std::string png_dir;    // side-by-side PNGs (image | classified | truth), when not empty
   size_t png_every = 10;  // of every n-th frame
   bool progress = true;   // a progress line on stderr every few seconds
+  // The own robot's pixels learned over the replay (core::SelfMaskLearner) are written here as a
+  // PNG for the calibration's camera.self_mask, when not empty.
+  std::string self_mask_png;
 };
 
 struct ReplayResult {
@@ -35,6 +38,8 @@ struct ReplayResult {
   size_t without_pose = 0;     // frames before the first pose, or with a NaN pose
   size_t unusable_images = 0;  // wrong encoding or size: labelled all unknown
   size_t with_truth = 0;
+  int self_mask_poses = 0;        // distinct poses the self mask was learned from
+  double self_mask_fraction = 0;  // of the imaged pixels
   core::RunEvaluation evaluation;
 };
 

@@ -1,0 +1,54 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/color_lut.hpp"
+#include "act_color/core/expected_class_model.hpp"
+#include "act_color/core/image_view.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+namespace core {
+
+// Learns the pixels that show the own robot (issue 12): mirror struts, the chassis ring, a camera
+// cable. Where the pose expects carpet or a line, they show neither, wherever the robot stands.
+// Each frame counts, for every pixel expected carpet or line, whether the table classifies its
+// color as carpet or line. A pixel is the own robot when it showed neither in at least
+// kMismatchFraction of the frames that looked at it, and its connected part of the image is one
+// the own robot makes: touching the chassis, or long along the radius and narrow across it (a
+// strut or cable). Robots and people on the field are compact and, once the robot has moved, are
+// seen at other pixels. The result is the calibration's self mask (CameraCalibration::self_mask).
+class SelfMaskLearner {
+ public:
+  // The calibration's own self mask is ignored: every imaged pixel is looked at.
+  explicit SelfMaskLearner(const Calibration& calibration);
+
+  // One frame: the image (the calibration's size), the pose it was taken at and the table that
+  // classifies it (e.g. an ActTrainer's after the frame's cycle). A frame whose pose has not moved
+  // kMinMoveM or kMinTurnRad from the last frame counted is not counted again, so that a robot
+  // standing still for minutes weighs as one look. Throws std::invalid_argument for an image of
+  // another size.
+  void add(const ImageView& image, const Pose2D& pose, const ColorLut& lut);
+
+  // Frames counted so far (distinct poses).
+  int frames() const { return frames_; }
+  // The mask (row-major, 1 = own robot); empty before any frame was counted.
+  std::vector<uint8_t> mask() const;
+
+  static constexpr double kMismatchFraction = 0.8;
+  static constexpr double kMinMoveM = 0.25;
+  static constexpr double kMinTurnRad = 0.17;  // 10 degrees
+
+ private:
+  Calibration calibration_;
+  ExpectedClassModel model_;
+  std::vector<uint16_t> looked_;
+  std::vector<uint16_t> mismatched_;
+  int frames_ = 0;
+  Pose2D last_pose_;
+};
+
+}  // namespace core
+}  // namespace act_color

@@ -1,0 +1,121 @@
+#include "act_color/core/self_mask_learner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace act_color {
+namespace core {
+namespace {
+
+Calibration withoutMask(Calibration c) {
+  c.camera.self_mask.clear();
+  c.camera.self_mask_file.clear();
+  return c;
+}
+
+// A part of the own robot is long along the radius (a strut, a cable): at least this many times its
+// mean width, and at least this fraction of the imaged ring (chassis to mirror rim).
+constexpr double kMinElongation = 3.0;
+constexpr double kMinRadialFraction = 0.15;
+// Or it touches the chassis (the chassis ring): its inner end within this many pixels of it.
+constexpr double kChassisTouchPx = 2.0;
+// A pixel must have been looked at in this fraction of the frames (at least 1).
+constexpr double kMinLookedFraction = 0.3;
+
+}  // namespace
+
+SelfMaskLearner::SelfMaskLearner(const Calibration& calibration)
+    : calibration_(withoutMask(calibration)), model_(calibration_) {
+  const size_t pixels = model_.pixels();
+  looked_.assign(pixels, 0);
+  mismatched_.assign(pixels, 0);
+}
+
+void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const ColorLut& lut) {
+  const auto& camera = model_.camera();
+  if (image.width != camera.width() || image.height != camera.height())
+    throw std::invalid_argument("image size does not match the calibration");
+  if (!pose.isFinite()) throw std::invalid_argument("pose is not finite");
+  if (frames_ > 0) {
+    const double moved = std::hypot(pose.x_m - last_pose_.x_m, pose.y_m - last_pose_.y_m);
+    const double turned = std::abs(std::remainder(pose.theta_rad - last_pose_.theta_rad, 2 * M_PI));
+    if (moved < kMinMoveM && turned < kMinTurnRad) return;
+  }
+  if (frames_ == std::numeric_limits<uint16_t>::max()) return;  // the counts are full
+  last_pose_ = pose;
+  ++frames_;
+  const PoseTransform transform(pose);
+  for (int v = 0; v < camera.height(); ++v) {
+    for (int u = 0; u < camera.width(); ++u) {
+      const size_t i = static_cast<size_t>(v) * camera.width() + u;
+      const uint8_t expected = model_.geometricClass(i, transform);
+      if (expected != kGreen && expected != kWhite) continue;
+      uint8_t c[3];
+      image.color(u, v, c);
+      const uint8_t k = lut.classOf(c[0], c[1], c[2]);
+      ++looked_[i];
+      if (k != kGreen && k != kWhite) ++mismatched_[i];
+    }
+  }
+}
+
+std::vector<uint8_t> SelfMaskLearner::mask() const {
+  const auto& camera = model_.camera();
+  const int width = camera.width(), height = camera.height();
+  std::vector<uint8_t> out;
+  if (frames_ == 0) return out;
+  const double min_looked = std::max(1.0, kMinLookedFraction * frames_);
+  cv::Mat candidates(height, width, CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      if (looked_[i] >= min_looked && mismatched_[i] >= kMismatchFraction * looked_[i])
+        candidates.at<uint8_t>(v, u) = 1;
+    }
+  }
+  // The parts the own robot makes, by their shape about the mirror axis.
+  cv::Mat labels;
+  const int parts = cv::connectedComponents(candidates, labels, 8, CV_32S);
+  const CameraCalibration& cal = calibration_.camera;
+  std::vector<double> r_min(parts, std::numeric_limits<double>::infinity()), r_max(parts, 0.0);
+  std::vector<double> count(parts, 0.0);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const int p = labels.at<int>(v, u);
+      if (p == 0) continue;
+      const double r = std::hypot(u - cal.center_u, v - cal.center_v);
+      r_min[p] = std::min(r_min[p], r);
+      r_max[p] = std::max(r_max[p], r);
+      count[p] += 1;
+    }
+  }
+  const double ring = std::max(1.0, cal.mirror_radius_px - cal.chassis_radius_px);
+  std::vector<uint8_t> own(parts, 0);
+  for (int p = 1; p < parts; ++p) {
+    const double length = r_max[p] - r_min[p] + 1;
+    const double mean_width = count[p] / length;
+    const bool strut = length >= kMinElongation * mean_width && length >= kMinRadialFraction * ring;
+    const bool chassis_ring = r_min[p] <= cal.chassis_radius_px + kChassisTouchPx;
+    own[p] = strut || chassis_ring;
+  }
+  cv::Mat mask(height, width, CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) mask.at<uint8_t>(v, u) = own[labels.at<int>(v, u)] ? 255 : 0;
+  }
+  // One pixel more all round: the blurred edges of a strut are neither carpet nor strut.
+  cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  out.assign(static_cast<size_t>(width) * height, 0);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      const size_t i = static_cast<size_t>(v) * width + u;
+      out[i] = mask.at<uint8_t>(v, u) != 0 && camera.ray(i).region != PixelRegion::kNotImaged;
+    }
+  }
+  return out;
+}
+
+}  // namespace core
+}  // namespace act_color

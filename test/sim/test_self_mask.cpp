@@ -1,0 +1,156 @@
+// Issue 12, item 3: the pixels that show the own robot (mirror struts) are learned from frames
+// with poses, kept as the calibration's self mask (a PNG beside it), and train nothing.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "act_color/core/act_trainer.hpp"
+#include "act_color/core/expected_class_model.hpp"
+#include "act_color/core/self_mask_learner.hpp"
+#include "act_color/sim/scene_family.hpp"
+#include "sim_test_util.hpp"
+
+namespace act_color {
+namespace {
+
+// Pixels the renderer draws as struts (core::kNotImaged and the chassis left out).
+std::vector<uint8_t> strutPixels(const sim::FamilyScene& scene) {
+  const auto& cam = scene.calibration.camera;
+  const core::OmniCameraModel model(cam);
+  std::vector<uint8_t> truth(static_cast<size_t>(cam.width) * cam.height, 0);
+  for (int v = 0; v < cam.height; ++v) {
+    for (int u = 0; u < cam.width; ++u) {
+      const auto region = model.ray(u, v).region;
+      if (region == core::PixelRegion::kNotImaged || region == core::PixelRegion::kChassis) continue;
+      const double r = std::hypot(u - cam.center_u, v - cam.center_v);
+      const double b = std::atan2(v - cam.center_v, u - cam.center_u);
+      for (const auto& s : scene.renderer.struts) {
+        if (std::abs(std::remainder(b - s.bearing_rad, 2 * M_PI)) <= s.half_width_rad && r >= s.inner_radius_px &&
+            r <= s.outer_radius_px) {
+          truth[static_cast<size_t>(v) * cam.width + u] = 1;
+        }
+      }
+    }
+  }
+  return truth;
+}
+
+// ACT over the scene's frames, every frame also given to the learner.
+std::vector<uint8_t> learn(const sim::FamilyScene& scene, int* frames_counted) {
+  const sim::Renderer renderer(scene.calibration, scene.renderer);
+  core::ActTrainer trainer(scene.calibration);
+  core::SelfMaskLearner learner(scene.calibration);
+  for (size_t i = 0; i < scene.scenario.frames.size(); ++i) {
+    const sim::LabeledFrame frame = renderer.render(scene.scenario.frames[i].scene);
+    const auto view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
+    const core::Pose2D& pose = scene.scenario.frames[i].told_pose;
+    if (i == 0) trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles - 1);
+    trainer.cycle(view, pose);
+    learner.add(view, pose, trainer.lut());
+  }
+  *frames_counted = learner.frames();
+  return learner.mask();
+}
+
+struct Coverage {
+  double struts = 0;  // fraction of the strut pixels masked
+  double others = 0;  // fraction of the other imaged pixels masked
+};
+
+Coverage coverage(const sim::FamilyScene& scene, const std::vector<uint8_t>& mask) {
+  const auto truth = strutPixels(scene);
+  const core::OmniCameraModel model(scene.calibration.camera);
+  double struts = 0, struts_masked = 0, others = 0, others_masked = 0;
+  for (size_t i = 0; i < truth.size(); ++i) {
+    if (model.ray(i).region == core::PixelRegion::kNotImaged) continue;
+    if (truth[i]) {
+      ++struts;
+      struts_masked += mask[i];
+    } else {
+      ++others;
+      others_masked += mask[i];
+    }
+  }
+  return {struts > 0 ? struts_masked / struts : 0.0, others_masked / others};
+}
+
+TEST(SelfMask, TheStrutsOfADrivingRobotAreLearnedAndNothingElse) {
+  // Tuning seed 0: 4 struts, two robots and two people, static and then driving.
+  const sim::FamilyScene scene = sim::makeFamilyScene(0);
+  ASSERT_EQ(scene.renderer.struts.size(), 4u);
+  int frames = 0;
+  const auto mask = learn(scene, &frames);
+  const Coverage c = coverage(scene, mask);
+  std::printf("4 struts, %d poses: %.2f of the strut pixels masked, %.4f of the others\n", frames, c.struts, c.others);
+  EXPECT_GE(frames, 4);
+  // Where a strut crosses the hall nothing is expected, so nothing is learned: about half of the
+  // strut pixels lie over the field.
+  EXPECT_GT(c.struts, 0.40);
+  EXPECT_LT(c.others, 0.01);  // the struts' blurred edges (one pixel all round)
+}
+
+TEST(SelfMask, NoStrutsNoMask) {
+  // Tuning seed 17: no struts, a person and four robots, driving.
+  const sim::FamilyScene scene = sim::makeFamilyScene(17);
+  ASSERT_TRUE(scene.renderer.struts.empty());
+  int frames = 0;
+  const auto mask = learn(scene, &frames);
+  EXPECT_LT(coverage(scene, mask).others, 0.001);
+}
+
+TEST(SelfMask, TheMaskIsSavedWithTheCalibrationAndTrainsNothing) {
+  char pattern[] = "/tmp/act_self_mask_XXXXXX";
+  const std::string dir = mkdtemp(pattern);
+  core::Calibration cal = sim_test::defaultCalibration();
+  auto& cam = cal.camera;
+  cam.self_mask.assign(static_cast<size_t>(cam.width) * cam.height, 0);
+  // A strut: a 6 px wide bar from the chassis to the rim, to the right of the centre.
+  for (int u = static_cast<int>(cam.center_u) + 30; u < cam.width; ++u) {
+    for (int dv = -3; dv < 3; ++dv) cam.self_mask[static_cast<size_t>(cam.center_v + dv) * cam.width + u] = 1;
+  }
+  cam.self_mask_file = "strut_mask.png";
+  core::saveSelfMask(cam, dir + "/strut_mask.png");
+  std::ofstream(dir + "/cal.yaml") << core::toYaml(cal);
+  const core::Calibration loaded = core::loadCalibration(dir + "/cal.yaml");
+  EXPECT_EQ(loaded.camera.self_mask_file, "strut_mask.png");
+  EXPECT_EQ(loaded.camera.self_mask, cam.self_mask);
+  EXPECT_EQ(core::toYaml(loaded), core::toYaml(cal));
+  // Masked pixels train nothing and are never off the field.
+  const core::ExpectedClassModel model(loaded);
+  const core::PoseTransform pose(core::Pose2D{0.0, 0.0, 0.0});
+  size_t masked = 0;
+  for (size_t i = 0; i < loaded.camera.self_mask.size(); ++i) {
+    if (!loaded.camera.self_mask[i] || model.camera().ray(i).region == core::PixelRegion::kNotImaged) continue;
+    ++masked;
+    EXPECT_EQ(model.camera().ray(i).region, core::PixelRegion::kSelf);
+    EXPECT_EQ(model.geometricClass(i, pose), core::kNotImaged);
+    EXPECT_FALSE(model.offField(i, pose));
+  }
+  EXPECT_GT(masked, 1000u);
+  // A mask of another size, or one that is not there, is an error naming the key.
+  cv::imwrite(dir + "/small.png", cv::Mat(10, 10, CV_8UC1, cv::Scalar(255)));
+  auto errorOf = [&](const std::string& file) -> std::string {
+    core::Calibration c = cal;
+    c.camera.self_mask_file = file;
+    std::ofstream(dir + "/bad.yaml") << core::toYaml(c);
+    try {
+      core::loadCalibration(dir + "/bad.yaml");
+    } catch (const core::CalibrationError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(errorOf("small.png").find("camera.self_mask: '" + dir + "/small.png' is 10x10 px"), std::string::npos);
+  EXPECT_NE(errorOf("missing.png").find("camera.self_mask: cannot read"), std::string::npos);
+  for (const char* f : {"strut_mask.png", "small.png", "cal.yaml", "bad.yaml"}) std::remove((dir + "/" + f).c_str());
+  rmdir(dir.c_str());
+}
+
+}  // namespace
+}  // namespace act_color
