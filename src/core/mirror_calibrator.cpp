@@ -104,7 +104,7 @@ ColorMasks colorMasks(const cv::Mat& bgr) {
 
 class LineDistanceMap {
  public:
-  explicit LineDistanceMap(const FieldCalibration& field, double cell_m = 0.02) : cell_m_(cell_m) {
+  explicit LineDistanceMap(const FieldCalibration& field, double cell_m = 0.01) : cell_m_(cell_m) {
     const FieldModel model(field);
     half_x_ = field.length_m / 2 + field.margin_m + 1.0;
     half_y_ = field.width_m / 2 + field.margin_m + 1.0;
@@ -118,6 +118,15 @@ class LineDistanceMap {
     }
     cv::distanceTransform(free, distance_, cv::DIST_L2, cv::DIST_MASK_PRECISE);
     distance_ *= cell_m_;
+    // Distance to the lines' middles: outside a line its distance plus half the width, inside
+    // half the width less the distance to its edge. The fit uses it: a line pixel anywhere across
+    // a painted line's width pulls towards its middle, so wide lines do not leave the profile
+    // loose by their width.
+    cv::Mat inside;
+    cv::distanceTransform(~free, inside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    const float half_width = static_cast<float>(field.line_width_m / 2);
+    middle_distance_ = distance_ - inside * cell_m_ + half_width;
+    middle_distance_ = cv::max(middle_distance_, 0.f);
   }
 
   // Points on the model's lines (cells on a line), about `spacing_m` apart.
@@ -141,22 +150,29 @@ class LineDistanceMap {
     return out;
   }
 
-  // Bilinear; `outside` beyond the grid.
-  double at(double x_m, double y_m, double outside = 10.0) const {
+  // Distance to the painted line, bilinear; `outside` beyond the grid.
+  double at(double x_m, double y_m, double outside = 10.0) const { return lookUp(distance_, x_m, y_m, outside); }
+  // Distance to the line's middle.
+  double middleAt(double x_m, double y_m, double outside = 10.0) const {
+    return lookUp(middle_distance_, x_m, y_m, outside);
+  }
+
+ private:
+  double lookUp(const cv::Mat& grid, double x_m, double y_m, double outside) const {
     const double fc = (x_m + half_x_) / cell_m_ - 0.5, fr = (y_m + half_y_) / cell_m_ - 0.5;
     if (!(fc >= 0 && fr >= 0 && fc < cols_ - 1 && fr < rows_ - 1)) return outside;
     const int c = static_cast<int>(fc), r = static_cast<int>(fr);
     const double ac = fc - c, ar = fr - r;
-    const float* p0 = distance_.ptr<float>(r) + c;
-    const float* p1 = distance_.ptr<float>(r + 1) + c;
+    const float* p0 = grid.ptr<float>(r) + c;
+    const float* p1 = grid.ptr<float>(r + 1) + c;
     return (1 - ar) * ((1 - ac) * p0[0] + ac * p0[1]) + ar * ((1 - ac) * p1[0] + ac * p1[1]);
   }
 
- private:
   double cell_m_;
   double half_x_ = 0, half_y_ = 0;
   int cols_ = 0, rows_ = 0;
-  cv::Mat distance_;  // CV_32F, metres
+  cv::Mat distance_;         // CV_32F, metres to the painted line
+  cv::Mat middle_distance_;  // CV_32F, metres to the line's middle
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -240,7 +256,7 @@ class LineFit {
       }
       const double d = model.height_m / std::tan(-e);
       const double b = p[2] + model.sign * std::atan2(dv, du);
-      (*out)[i] = map_.at(p[3] + d * std::cos(b), p[4] + d * std::sin(b), kOff);
+      (*out)[i] = map_.middleAt(p[3] + d * std::cos(b), p[4] + d * std::sin(b), kOff);
     }
   }
 
@@ -255,15 +271,26 @@ class LineFit {
 
   // An omnidirectional camera sees far at its mirror's rim; without this a fit can shrink the
   // whole image onto one line (every pixel an inlier). Soft: penalised below rim_reach_m.
+  // Also the floor next to the chassis is not at the robot's centre (at least 8 cm away), and
+  // a tan profile's a stays within 0.3-30 m (a tiny a with the horizon inside the mirror is
+  // another collapse: everything near the robot but a thin ring).
   double reachPrior(const Model& model, const Eigen::VectorXd& p) const {
     const std::vector<double> knot_e =
         model.kind == ProfileKind::kMonotone ? model.knotElevations(p) : std::vector<double>{};
+    auto squaredLog = [](double ratio) { return ratio > 1.0 ? 4.0 * std::log(ratio) * std::log(ratio) : 0.0; };
+    double c = 0.0;
     const double e = model.elevation(rim_px_, p, knot_e);
-    if (!(e < 0)) return 0.0;  // the rim looks at or above the horizon
-    const double short_by = std::max(0.0, std::log(rim_reach_m_ / (model.height_m / std::tan(-e))));
-    return 4.0 * short_by * short_by;
+    if (e < 0) c += squaredLog(rim_reach_m_ / (model.height_m / std::tan(-e)));  // else: sees the horizon
+    const double e_near = model.elevation(near_px_, p, knot_e);
+    if (e_near < 0) c += squaredLog(0.08 / (model.height_m / std::tan(-e_near)));
+    if (model.kind == ProfileKind::kTan) {
+      const double a = std::exp(p[Model::kGeometry]);
+      c += squaredLog(0.3 / a) + squaredLog(a / 30.0);
+    }
+    return c;
   }
-  void setReach(double rim_px, double rim_reach_m) {
+  void setReach(double near_px, double rim_px, double rim_reach_m) {
+    near_px_ = near_px;
     rim_px_ = rim_px;
     rim_reach_m_ = rim_reach_m;
   }
@@ -318,13 +345,13 @@ class LineFit {
   const std::vector<cv::Point2f>& pixels_;
   const MirrorCalibratorOptions& options_;
   mutable std::vector<double> scratch_;
-  double rim_px_ = 1e9, rim_reach_m_ = 0.0;
+  double near_px_ = 0, rim_px_ = 1e9, rim_reach_m_ = 0.0;
   std::vector<Eigen::Vector2d> model_points_;
   cv::Mat pixel_distance_px_;
   double cover_r_min_ = 0, cover_r_max_ = 0;
 
  public:
-  static constexpr double kCoverageWeight = 0.5;
+  static constexpr double kCoverageWeight = 1.5;
 };
 
 // Nelder-Mead simplex minimisation (the truncated cost is not smooth enough for derivatives far
@@ -381,25 +408,47 @@ Eigen::VectorXd nelderMead(const std::function<double(const Eigen::VectorXd&)>& 
   return x[best];
 }
 
-// Levenberg-Marquardt on the truncated residuals (a pixel farther than tau from every line is an
-// outlier and does not pull), numeric Jacobian; `regularize` adds rows to the residual vector.
+Eigen::VectorXd leastSquares(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& residuals,
+                             Eigen::VectorXd p, int iterations);
+
+// Levenberg-Marquardt on the line pixels' distances, iteratively reweighted: the inliers (closer
+// than tau) are chosen at the current fit, fitted by plain least squares (a smooth problem), and
+// chosen again; outliers do not pull. Numeric Jacobian; `regularize` adds rows.
 Eigen::VectorXd levenbergMarquardt(
     const LineFit& fit, const Model& model, Eigen::VectorXd p, double tau, int iterations,
     const std::function<void(const Eigen::VectorXd&, std::vector<double>*)>& regularize) {
-  const int n = static_cast<int>(p.size());
+  std::vector<uint8_t> inlier;
+  auto choose = [&](const Eigen::VectorXd& q) {
+    std::vector<double> d;
+    fit.distances(model, q, &d);
+    inlier.resize(d.size());
+    for (size_t i = 0; i < d.size(); ++i) inlier[i] = d[i] < tau;
+  };
   auto residuals = [&](const Eigen::VectorXd& q, Eigen::VectorXd* out) {
     std::vector<double> d;
     fit.distances(model, q, &d);
     std::vector<double> extra;
     if (regularize) regularize(q, &extra);
     out->resize(static_cast<long>(d.size() + extra.size() + 1));
-    for (size_t i = 0; i < d.size(); ++i) (*out)[static_cast<long>(i)] = std::min(d[i], tau);
+    for (size_t i = 0; i < d.size(); ++i) (*out)[static_cast<long>(i)] = inlier[i] ? std::min(d[i], 3 * tau) : 0.0;
     for (size_t i = 0; i < extra.size(); ++i) (*out)[static_cast<long>(d.size() + i)] = extra[i];
-    // Priors and coverage (the model's lines found in the image) as one more residual.
-    const double extra_cost = fit.prior(q) + fit.reachPrior(model, q) +
-                              LineFit::kCoverageWeight * (1.0 - fit.coverage(model, q, std::max(2.5, 40.0 * tau)));
+    // The priors as one more residual. Not the coverage: the simplex has found the basin, and its
+    // numeric derivative (a distance transform in whole pixels) would only add noise here.
+    const double extra_cost = fit.prior(q) + fit.reachPrior(model, q);
     (*out)[out->size() - 1] = std::sqrt(extra_cost * static_cast<double>(d.size())) * tau;
   };
+  constexpr int kRounds = 4;
+  for (int round = 0; round < kRounds; ++round) {
+    choose(p);
+    p = leastSquares(residuals, p, iterations / kRounds);
+  }
+  return p;
+}
+
+// Levenberg-Marquardt with a numeric Jacobian on the parameter layout of Model.
+Eigen::VectorXd leastSquares(const std::function<void(const Eigen::VectorXd&, Eigen::VectorXd*)>& residuals,
+                             Eigen::VectorXd p, int iterations) {
+  const int n = static_cast<int>(p.size());
   Eigen::VectorXd steps(n);
   for (int i = 0; i < n; ++i) steps[i] = i < 2 ? 0.25 : (i < 3 ? 1e-3 : (i < 5 ? 4e-3 : 2e-3));
   Eigen::VectorXd res;
@@ -496,30 +545,38 @@ CameraCalibration cameraOf(const Model& model, const Eigen::VectorXd& p, const I
   return c;
 }
 
-// How well the yellow and blue pixels point at their goals (mean cosine; 0 without goal colors).
+// How well the yellow and blue pixels point at their goals: pixels in the sector of bearings of
+// a goal (its posts from the robot, 4 degrees wider) and not on the field in front of it vote for
+// (their goal's color) or against (the other one's) the fit, in [-1, 1]; 0 without votes. Other
+// directions are not counted: the hall may hold yellow and blue things anywhere.
 double goalAgreement(const Model& model, const Eigen::VectorXd& p, const std::vector<cv::Point2f>& yellow,
                      const std::vector<cv::Point2f>& blue, const FieldCalibration& field) {
-  double sum = 0;
-  size_t n = 0;
-  const double half_l = field.length_m / 2, half_w = field.width_m / 2;
+  const double half_l = field.length_m / 2;
   const std::vector<double> knot_e =
       model.kind == ProfileKind::kMonotone ? model.knotElevations(p) : std::vector<double>{};
-  for (int goal = 0; goal < 2; ++goal) {
-    const double gx = (goal == 0 ? 1 : -1) * field.yellow_goal_x_sign * (half_l + field.goal_depth_m / 2);
-    for (const cv::Point2f& px : goal == 0 ? yellow : blue) {
+  // Sector and goal-line distance of the goal at x = side * half_l.
+  auto inGoalSector = [&](double side, double b, double d) {
+    const double gx = side * half_l - p[3];
+    const double b1 = std::atan2(field.goal_width_m / 2 - p[4], gx),
+                 b2 = std::atan2(-field.goal_width_m / 2 - p[4], gx);
+    const double mid = std::atan2(std::sin(b1) + std::sin(b2), std::cos(b1) + std::cos(b2));
+    const double half = 0.5 * std::abs(wrapAngle(b1 - b2)) + 4.0 * kPi / 180;
+    if (std::abs(wrapAngle(b - mid)) > half) return false;
+    return d > std::abs(gx) / std::max(0.2, std::abs(std::cos(b))) - 0.3;  // at or beyond the goal line
+  };
+  double agree = 0, disagree = 0;
+  for (int color = 0; color < 2; ++color) {
+    const double own_side = (color == 0 ? 1.0 : -1.0) * field.yellow_goal_x_sign;
+    for (const cv::Point2f& px : color == 0 ? yellow : blue) {
       const double du = px.x - p[0], dv = px.y - p[1];
-      const double b = p[2] + model.sign * std::atan2(dv, du);
+      const double b = wrapAngle(p[2] + model.sign * std::atan2(dv, du));
       const double e = model.elevation(std::hypot(du, dv), p, knot_e);
-      if (e < 0) {  // a ball or a colored patch on the field itself is no goal
-        const double d = model.height_m / std::tan(-e);
-        const double wx = p[3] + d * std::cos(b), wy = p[4] + d * std::sin(b);
-        if (std::abs(wx) < half_l - 0.5 && std::abs(wy) < half_w) continue;
-      }
-      sum += std::cos(b - std::atan2(0.0 - p[4], gx - p[3]));
-      ++n;
+      const double d = e < 0 ? model.height_m / std::tan(-e) : 1e9;  // above the horizon: far away
+      if (inGoalSector(own_side, b, d)) agree += 1;
+      if (inGoalSector(-own_side, b, d)) disagree += 1;
     }
   }
-  return n > 0 ? sum / static_cast<double>(n) : 0.0;
+  return (agree - disagree) / (agree + disagree + 1.0);
 }
 
 std::vector<cv::Point2f> maskPixels(const cv::Mat& mask, const ImageGeometry& g, size_t max_count, uint32_t seed) {
@@ -730,7 +787,8 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
   LineFit full_fit(map, pixels, options_);
   // At the rim the camera sees at least across 40% of the field's width (MSL mirrors see the
   // horizon; NuBot's reach about 10 m).
-  for (LineFit* f : {&coarse_fit, &middle_fit, &full_fit}) f->setReach(g.mirror_radius_px, 0.4 * field_.width_m);
+  for (LineFit* f : {&coarse_fit, &middle_fit, &full_fit})
+    f->setReach(g.chassis_radius_px + 2, g.mirror_radius_px, 0.4 * field_.width_m);
   {
     cv::Mat not_line(bgr.size(), CV_8UC1, cv::Scalar(255));
     for (const cv::Point2f& px : pixels) not_line.at<uint8_t>(cvRound(px.y), cvRound(px.x)) = 0;
@@ -809,7 +867,7 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
     Eigen::VectorXd step(7);
     step << 1.0, 1.0, 0.02, 0.05, 0.05, 0.05, 0.03;
     const auto f = [&](const Eigen::VectorXd& q) { return middle_fit.cost(c.model, q, 0.08); };
-    c.p = nelderMead(f, c.p, step, 300, &c.cost);
+    c.p = nelderMead(f, c.p, step, 500, &c.cost);
     variants.push_back(c);
   };
   if (!options_.bearing_sign) variant(best, true, false);
@@ -821,35 +879,45 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
       std::min_element(variants.begin(), variants.end(), [](const Candidate& a, const Candidate& b) {
         return a.cost < b.cost;
       })->cost;
-  std::vector<Candidate> equal;
-  // Costs are negative with the coverage reward: "within a few percent" of the range it spans.
-  const double worst_pixel_cost = 1.0;
+  // Costs are negative with the coverage reward: margins are fractions of the range they span
+  // (a pixel costs at most 1).
+  const auto within = [&](const Candidate& c, double fraction) {
+    return c.cost <= best_cost + fraction * (1.0 + std::abs(best_cost));
+  };
+  std::vector<Candidate> pool;
   for (const Candidate& c : variants) {
-    if (c.cost <= best_cost + 0.03 * (worst_pixel_cost + std::abs(best_cost))) equal.push_back(c);
+    if (within(c, 0.03)) pool.push_back(c);
   }
-  std::vector<Candidate> pool = equal;
   const bool sign_ambiguous = std::any_of(pool.begin(), pool.end(),
                                           [&](const Candidate& c) { return c.model.sign != pool.front().model.sign; });
-  if (sign_ambiguous) {
-    pool.erase(std::remove_if(pool.begin(), pool.end(),
-                              [&](const Candidate& c) { return c.model.sign != options_.bearing_sign_prior; }),
-               pool.end());
-    result.notes.push_back("bearing sign: the image fits either sign (a pose near the field's long axis); took " +
-                           std::to_string(options_.bearing_sign_prior) + " (--bearing-sign to change)");
-  }
   std::sort(pool.begin(), pool.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
-  Candidate chosen = pool.front();
-  if (pool.size() > 1) {  // a half turn fits as well: the goal colors tell
-    const Candidate& other = pool[1];
+  int sign = pool.front().model.sign;
+  if (sign_ambiguous) {
+    sign = options_.bearing_sign_prior;
+    result.notes.push_back("bearing sign: the image fits either sign (a pose near the field's long axis); took " +
+                           std::to_string(sign) + " (--bearing-sign to change)");
+  }
+  // The best of that sign, and its half turn when that fits nearly as well: the goal colors tell.
+  std::vector<Candidate> same_sign;
+  for (const Candidate& c : variants) {
+    if (c.model.sign == sign) same_sign.push_back(c);
+  }
+  std::sort(same_sign.begin(), same_sign.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+  Candidate chosen = same_sign.front();
+  for (size_t i = 1; i < same_sign.size(); ++i) {
+    const Candidate& other = same_sign[i];
+    if (std::abs(wrapAngle(other.p[2] - chosen.p[2])) < kPi / 2 || !within(other, 0.1)) continue;
     const double here = goalAgreement(chosen.model, chosen.p, yellow, blue, field_);
     const double there = goalAgreement(other.model, other.p, yellow, blue, field_);
-    if (there > here) chosen = other;
-    result.notes.push_back(std::abs(here - there) > 0.2
-                               ? "heading: the lines fit a half turn too; the goal colors chose (agreement " +
-                                     fixed(std::max(here, there), 2) + " against " + fixed(std::min(here, there), 2) +
-                                     ")"
-                               : "heading: the lines fit a half turn too and the goal colors cannot tell; check the "
-                                 "overlay");
+    const bool decided = std::abs(here - there) > 0.2;
+    if (decided && there > here) chosen = other;
+    result.notes.push_back(decided ? "heading: the lines fit a half turn nearly as well; the goal colors chose "
+                                     "(agreement " +
+                                         fixed(std::max(here, there), 2) + " against " +
+                                         fixed(std::min(here, there), 2) + ")"
+                                   : "heading: the lines fit a half turn nearly as well and the goal colors cannot "
+                                     "tell; check the overlay");
+    break;
   }
 
   // Refinement with all pixels, then the monotone profile from it; the profile with the smaller
@@ -861,12 +929,12 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
   std::vector<double> radii;
   for (const cv::Point2f& px : pixels) radii.push_back(std::hypot(px.x - tan.p[0], px.y - tan.p[1]));
   std::sort(radii.begin(), radii.end());
-  const double r_lo = std::max(g.chassis_radius_px, radii[radii.size() / 200]);
+  const double r_lo = g.chassis_radius_px + 1.0;  // from the chassis: the smoothness carries the fit inwards
   const double r_hi = std::min(g.mirror_radius_px, radii[radii.size() - 1 - radii.size() / 200]);
   Candidate mono;
   mono.model = tan.model;
   mono.model.kind = ProfileKind::kMonotone;
-  constexpr int kKnots = 12;
+  constexpr int kKnots = 18;
   for (int i = 0; i < kKnots; ++i) {
     const double t = static_cast<double>(i) / (kKnots - 1);
     mono.model.knots_r.push_back(r_lo + (r_hi - r_lo) * (1.0 - std::pow(1.0 - t, 1.4)));
@@ -901,8 +969,9 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
       rows->push_back(smooth * curvature);
     }
   };
-  mono.p = levenbergMarquardt(full_fit, mono.model, mono.p, 0.08, 40, regularize);
-  mono.p = levenbergMarquardt(full_fit, mono.model, mono.p, 0.05, 40, regularize);
+  // From a wide inlier distance down: where the tan shape was wrong (often near the robot) its
+  // line pixels are still inliers when the monotone profile starts.
+  for (double tau : {0.2, 0.1, 0.05}) mono.p = levenbergMarquardt(full_fit, mono.model, mono.p, tau, 40, regularize);
 
   auto finish = [&](const Candidate& c, Calibration* cal, Pose2D* refined_pose) {
     // psi = heading + offset: keep the given heading and fit the offset, or the other way round.
@@ -926,8 +995,25 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
   result.tan_b_per_px = kHalfPi / std::exp(tan.p[6]);
   result.tan_median_m = tan_res.median_m;
   result.monotone_median_m = mono_res.median_m;
-  const bool use_mono =
-      mono_res.median_m < 0.85 * tan_res.median_m && mono_res.inlier_fraction >= tan_res.inlier_fraction - 0.01;
+  // Chosen by the RMS distance to the lines' middles over the pixels that both profiles take for
+  // inliers (the medians are often 0: most pixels lie on a painted line; and outliers would add
+  // the same to both); the monotone profile only when clearly better, as it has more freedom.
+  {
+    std::vector<double> d_tan, d_mono;
+    full_fit.distances(tan.model, tan.p, &d_tan);
+    full_fit.distances(mono.model, mono.p, &d_mono);
+    double sum_tan = 0, sum_mono = 0;
+    size_t common = 0;
+    for (size_t i = 0; i < d_tan.size(); ++i) {
+      if (d_tan[i] >= options_.inlier_distance_m || d_mono[i] >= options_.inlier_distance_m) continue;
+      sum_tan += d_tan[i] * d_tan[i];
+      sum_mono += d_mono[i] * d_mono[i];
+      ++common;
+    }
+    result.tan_rms_m = std::sqrt(sum_tan / static_cast<double>(std::max<size_t>(1, common)));
+    result.monotone_rms_m = std::sqrt(sum_mono / static_cast<double>(std::max<size_t>(1, common)));
+  }
+  const bool use_mono = result.monotone_rms_m < 0.95 * result.tan_rms_m;
   result.profile = use_mono ? "monotone" : "tan";
   result.calibration = use_mono ? mono_cal : tan_cal;
   result.pose = use_mono ? mono_pose : tan_pose;

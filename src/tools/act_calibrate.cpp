@@ -206,8 +206,11 @@ int main(int argc, char** argv) {
       pose = fit.pose;
       line_pixels = fit.line_pixels;
       const auto& c = calibration.camera;
-      std::printf("profile: %s (median residual: a tan(b r) %.3f m with a = %.3f m, b = %.6f /px; monotone %.3f m)\n",
-                  fit.profile.c_str(), fit.tan_median_m, fit.tan_a_m, fit.tan_b_per_px, fit.monotone_median_m);
+      std::printf(
+          "profile: %s (RMS to the lines' middles over common inliers: a tan(b r) %.4f m with a = %.3f m, b = %.6f "
+          "/px; "
+          "monotone %.4f m)\n",
+          fit.profile.c_str(), fit.tan_rms_m, fit.tan_a_m, fit.tan_b_per_px, fit.monotone_rms_m);
       std::printf("camera: centre (%.1f, %.1f), bearing sign %d, offset %.4f rad, chassis %.0f px, mirror %.0f px\n",
                   c.center_u, c.center_v, c.bearing_sign, c.bearing_offset_rad, c.chassis_radius_px,
                   c.mirror_radius_px);

@@ -64,8 +64,11 @@ struct MirrorFit {
   std::string profile;                       // "tan" (d = a tan(b r)) or "monotone" (piecewise linear elevation)
   double tan_a_m = 0.0, tan_b_per_px = 0.0;  // the best a tan(b r) fit (also when not chosen)
   double tan_median_m = 0.0, monotone_median_m = 0.0;  // median residual of either profile
-  LineResidual residual;                               // of the chosen profile
-  std::vector<cv::Point2f> line_pixels;                // candidates found in the image
+  // RMS distance to the lines' middles over the line pixels both profiles take for inliers: the
+  // profile with the smaller one is chosen (the monotone one only when 5% smaller).
+  double tan_rms_m = 0.0, monotone_rms_m = 0.0;
+  LineResidual residual;                 // of the chosen profile
+  std::vector<cv::Point2f> line_pixels;  // candidates found in the image
   ImageGeometry image_geometry;
   std::vector<std::string> notes;  // what was assumed (sign prior, goal colors, ...)
 };
