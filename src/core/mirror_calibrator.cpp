@@ -306,7 +306,15 @@ class LineFit {
       const double over_h = std::max(0.0, std::abs(heading) - options_.heading_tolerance_rad);
       c += 25.0 * over_h * over_h;
     }
+    // The chassis' centre is a good estimate of the mirror axis: lines alone, far apart, let the
+    // centre trade against the profile.
+    const double off_px = std::hypot(p[0] - center_px_.x(), p[1] - center_px_.y()) / center_sigma_px_;
+    c += 0.005 * off_px * off_px;
     return c;
+  }
+  void setCenterPrior(const Eigen::Vector2d& center_px, double sigma_px) {
+    center_px_ = center_px;
+    center_sigma_px_ = sigma_px;
   }
 
   size_t size() const { return pixels_.size(); }
@@ -347,6 +355,8 @@ class LineFit {
   mutable std::vector<double> scratch_;
   double near_px_ = 0, rim_px_ = 1e9, rim_reach_m_ = 0.0;
   std::vector<Eigen::Vector2d> model_points_;
+  Eigen::Vector2d center_px_{0.0, 0.0};
+  double center_sigma_px_ = 1e9;
   cv::Mat pixel_distance_px_;
   double cover_r_min_ = 0, cover_r_max_ = 0;
 
@@ -737,6 +747,17 @@ std::vector<cv::Point2f> MirrorCalibrator::findLinePixels(const cv::Mat& bgr, co
   const int kg = std::max(5, (k / 2) | 1);
   cv::dilate(masks.green, near_green, cv::getStructuringElement(cv::MORPH_ELLIPSE, {kg, kg}));
   cv::Mat line = bright & masks.whiteish & near_green & ~masks.green;
+  // Lines are long connected curves; specks (noise, texture, clutter edges) are not.
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(line, labels, stats, centroids, 8);
+  const int min_area = 4;
+  for (int v = 0; v < line.rows; ++v) {
+    uint8_t* row = line.ptr<uint8_t>(v);
+    const int* label = labels.ptr<int>(v);
+    for (int u = 0; u < line.cols; ++u) {
+      if (row[u] && label[u] > 0 && label[u] < n && stats.at<int>(label[u], cv::CC_STAT_AREA) < min_area) row[u] = 0;
+    }
+  }
   return maskPixels(line, g, 4000, 12345u);
 }
 
@@ -755,7 +776,7 @@ LineResidual MirrorCalibrator::residual(const CameraCalibration& camera, const P
   return out;
 }
 
-MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
+MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   if (bgr.empty() || bgr.type() != CV_8UC3) throw CalibrationFitError("the image must be 8-bit with 3 channels");
   MirrorFit result;
   result.image_geometry = estimateImageGeometry(bgr);
@@ -788,7 +809,10 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
   // At the rim the camera sees at least across 40% of the field's width (MSL mirrors see the
   // horizon; NuBot's reach about 10 m).
   for (LineFit* f : {&coarse_fit, &middle_fit, &full_fit})
+    {
     f->setReach(g.chassis_radius_px + 2, g.mirror_radius_px, 0.4 * field_.width_m);
+    f->setCenterPrior(g.center_px, 0.01 * g.mirror_radius_px);
+  }
   {
     cv::Mat not_line(bgr.size(), CV_8UC1, cv::Scalar(255));
     for (const cv::Point2f& px : pixels) not_line.at<uint8_t>(cvRound(px.y), cvRound(px.x)) = 0;
@@ -941,6 +965,7 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
   }
   mono.p.resize(Model::kGeometry + kKnots);
   mono.p.head(Model::kGeometry) = tan.p.head(Model::kGeometry);
+  std::vector<double> tan_log_d;  // the tan fit at the knots: the shape where no line decides
   {
     double previous = 0;
     const double a = std::exp(tan.p[5]), r_h = std::exp(tan.p[6]);
@@ -950,6 +975,7 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
       double d = a * std::tan(kHalfPi * r / r_h);
       if (i > 0) d = std::max(d, previous * 1.02);
       mono.p[Model::kGeometry + i] = i == 0 ? std::log(d) : std::log(d / previous - 1.0);
+      tan_log_d.push_back(std::log(d));
       previous = d;
     }
   }
@@ -968,10 +994,13 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
       const double curvature = ((ld[k + 1] - ld[k]) / h1 - (ld[k] - ld[k - 1]) / h0) * 0.5 * (h0 + h1);
       rows->push_back(smooth * curvature);
     }
+    // Weakly towards the tan fit: between lines far apart (a lab field seen from its centre) the
+    // data leave the profile free, and there the rigid family's shape is the better guess.
+    for (int k = 0; k < kKnots; ++k) rows->push_back(0.25 * smooth * (ld[k] - tan_log_d[k]));
   };
   // From a wide inlier distance down: where the tan shape was wrong (often near the robot) its
   // line pixels are still inliers when the monotone profile starts.
-  for (double tau : {0.2, 0.1, 0.05}) mono.p = levenbergMarquardt(full_fit, mono.model, mono.p, tau, 40, regularize);
+  for (double tau : {0.12, 0.08, 0.05}) mono.p = levenbergMarquardt(full_fit, mono.model, mono.p, tau, 40, regularize);
 
   auto finish = [&](const Candidate& c, Calibration* cal, Pose2D* refined_pose) {
     // psi = heading + offset: keep the given heading and fit the offset, or the other way round.
@@ -1013,21 +1042,52 @@ MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
     result.tan_rms_m = std::sqrt(sum_tan / static_cast<double>(std::max<size_t>(1, common)));
     result.monotone_rms_m = std::sqrt(sum_mono / static_cast<double>(std::max<size_t>(1, common)));
   }
-  const bool use_mono = result.monotone_rms_m < 0.95 * result.tan_rms_m;
+  const bool use_mono = options_.profile == "monotone" ||
+                        (options_.profile != "tan" && result.monotone_rms_m < 0.95 * result.tan_rms_m &&
+                         mono_res.inlier_fraction >= tan_res.inlier_fraction - 0.01);
   result.profile = use_mono ? "monotone" : "tan";
   result.calibration = use_mono ? mono_cal : tan_cal;
   result.pose = use_mono ? mono_pose : tan_pose;
   result.residual = use_mono ? mono_res : tan_res;
   validateCalibration(result.calibration, "act_calibrate");
 
-  if (!(result.residual.median_m <= options_.max_median_residual_m) ||
-      result.residual.inlier_fraction < options_.min_inlier_fraction) {
-    throw CalibrationFitError("no fit: median line-pixel residual " + fixed(result.residual.median_m, 3) +
-                              " m (limit " + fixed(options_.max_median_residual_m, 3) + "), inlier fraction " +
-                              fixed(result.residual.inlier_fraction, 2) + " (limit " +
-                              fixed(options_.min_inlier_fraction, 2) + ") over " + std::to_string(pixels.size()) +
-                              " line pixels: wrong field, pose or image?");
+  // Carpet next to the lines must not land on them: a fit that puts carpet on the lines as readily
+  // as line pixels explains nothing (a flexible profile can bend any image onto a few lines).
+  {
+    cv::Mat carpet;
+    cv::erode(masks.green, carpet, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
+    const std::vector<cv::Point2f> carpet_pixels = maskPixels(carpet, g, 3000, 9u);
+    const std::vector<double> d =
+        lineDistances(map, result.calibration.camera, result.pose, carpet_pixels);
+    size_t on_line = 0, on_floor = 0;
+    for (double x : d) {
+      on_floor += std::isfinite(x);
+      on_line += x <= 0.0;
+    }
+    result.carpet_on_lines = on_floor > 0 ? static_cast<double>(on_line) / static_cast<double>(on_floor) : 1.0;
   }
+  return result;
+}
+
+std::string MirrorCalibrator::rejection(const MirrorFit& fit) const {
+  if (fit.carpet_on_lines > options_.max_carpet_on_lines) {
+    return "no fit: " + fixed(100 * fit.carpet_on_lines, 1) + "% of the carpet pixels land on the model's lines (limit " +
+           fixed(100 * options_.max_carpet_on_lines, 1) + "%): wrong field, pose or image?";
+  }
+  if (!(fit.residual.median_m <= options_.max_median_residual_m) ||
+      fit.residual.inlier_fraction < options_.min_inlier_fraction) {
+    return "no fit: median line-pixel residual " + fixed(fit.residual.median_m, 3) + " m (limit " +
+           fixed(options_.max_median_residual_m, 3) + "), inlier fraction " + fixed(fit.residual.inlier_fraction, 2) +
+           " (limit " + fixed(options_.min_inlier_fraction, 2) + ") over " + std::to_string(fit.line_pixels.size()) +
+           " line pixels: wrong field, pose or image?";
+  }
+  return "";
+}
+
+MirrorFit MirrorCalibrator::fit(const cv::Mat& bgr) const {
+  MirrorFit result = fitUnchecked(bgr);
+  const std::string why = rejection(result);
+  if (!why.empty()) throw CalibrationFitError(why);
   return result;
 }
 

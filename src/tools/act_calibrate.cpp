@@ -37,8 +37,11 @@ const char* const kUsage =
     "  --chassis-radius PX   the own chassis, instead of the one found\n"
     "  --bearing-sign S      1 or -1 instead of fitting it (used when the image cannot tell; default 1)\n"
     "  --bearing-offset RAD  keep this offset and refine the heading instead\n"
+    "  --profile P           tan (d = a tan(b r)), monotone (piecewise linear elevation) or auto\n"
+    "                        (default: the monotone one when its residual is 5% smaller)\n"
     "  --max-residual M      reject above this median line-pixel residual (default 0.05 m)\n"
     "  --min-inliers F       reject below this fraction of line pixels within 0.08 m (default 0.5)\n"
+    "  --max-carpet-on-lines F  reject when more of the carpet lands on the model's lines (default 0.1)\n"
     "  --output CAL.yaml     write the calibration (validated first)\n"
     "  --overlay OUT.png     the image with the model's lines (magenta) and the line pixels found\n"
     "  --whites FILE         also measure hand-picked line pixels ('x y' per line, NuBot's whites.txt)\n"
@@ -128,6 +131,13 @@ int main(int argc, char** argv) {
         options.max_median_residual_m = number(value(), arg);
       } else if (arg == "--min-inliers") {
         options.min_inlier_fraction = number(value(), arg);
+      } else if (arg == "--profile") {
+        options.profile = value();
+        if (options.profile != "auto" && options.profile != "tan" && options.profile != "monotone") {
+          throw std::invalid_argument("--profile must be auto, tan or monotone");
+        }
+      } else if (arg == "--max-carpet-on-lines") {
+        options.max_carpet_on_lines = number(value(), arg);
       } else if (arg == "--output") {
         output = value();
       } else if (arg == "--overlay") {
@@ -169,6 +179,7 @@ int main(int argc, char** argv) {
     core::MirrorCalibrator calibrator(calibration.field, options);
     core::Pose2D pose = options.pose;
     std::vector<cv::Point2f> line_pixels;
+    std::string rejected;  // why the fit is refused; its overlay is still written
 
     if (!check.empty()) {
       if (image.empty()) return usage("--check needs --image");
@@ -201,11 +212,14 @@ int main(int argc, char** argv) {
       }
     } else {
       if (image.empty()) return usage("give --image (or --nubot, --check)");
-      const core::MirrorFit fit = calibrator.fit(image);
+      const core::MirrorFit fit = calibrator.fitUnchecked(image);
       calibration = fit.calibration;
       pose = fit.pose;
       line_pixels = fit.line_pixels;
       const auto& c = calibration.camera;
+      const core::ImageGeometry& g = fit.image_geometry;
+      std::printf("image: mirror centre (%.1f, %.1f) from the chassis, rim %.0f px, chassis %.0f px; %zu line pixels\n",
+                  g.center_px.x(), g.center_px.y(), g.mirror_radius_px, g.chassis_radius_px, fit.line_pixels.size());
       std::printf(
           "profile: %s (RMS to the lines' middles over common inliers: a tan(b r) %.4f m with a = %.3f m, b = %.6f "
           "/px; "
@@ -217,6 +231,8 @@ int main(int argc, char** argv) {
       std::printf("pose: %.3f, %.3f, %.4f\n", pose.x_m, pose.y_m, pose.theta_rad);
       for (const std::string& note : fit.notes) std::printf("note: %s\n", note.c_str());
       printResidual("residual", fit.residual);
+      std::printf("carpet pixels on the model's lines: %.1f%%\n", 100 * fit.carpet_on_lines);
+      rejected = calibrator.rejection(fit);
     }
     if (!whites.empty()) {
       printResidual("whites " + whites, calibrator.residual(calibration.camera, pose, readWhites(whites)));
@@ -227,6 +243,7 @@ int main(int argc, char** argv) {
         throw std::runtime_error(overlay + ": cannot be written");
       }
     }
+    if (!rejected.empty()) throw core::CalibrationFitError(rejected + (overlay.empty() ? "" : "; see " + overlay));
     if (!output.empty()) {
       core::validateCalibration(calibration, output);
       std::ofstream file(output);

@@ -41,6 +41,8 @@ struct MirrorCalibratorOptions {
   double min_inlier_fraction = 0.5;
   int min_line_pixels = 150;
   double inlier_distance_m = 0.08;  // a line pixel this close to a model line is an inlier
+  std::string profile = "auto";  // "tan", "monotone" or "auto": the one with the smaller residual
+  double max_carpet_on_lines = 0.1;  // fraction of carpet pixels the fit may put on painted lines
 };
 
 // Mirror centre and radii as seen in the image (before the line fit).
@@ -68,6 +70,7 @@ struct MirrorFit {
   // profile with the smaller one is chosen (the monotone one only when 5% smaller).
   double tan_rms_m = 0.0, monotone_rms_m = 0.0;
   LineResidual residual;                 // of the chosen profile
+  double carpet_on_lines = 0.0;          // fraction of carpet pixels that land on a painted model line
   std::vector<cv::Point2f> line_pixels;  // candidates found in the image
   ImageGeometry image_geometry;
   std::vector<std::string> notes;  // what was assumed (sign prior, goal colors, ...)
@@ -86,6 +89,10 @@ class MirrorCalibrator {
   // Fits the camera to a BGR image (8-bit, 3 channels). Throws CalibrationFitError when the image
   // shows too few line pixels or no fit within the options' residual and inlier limits.
   MirrorFit fit(const cv::Mat& bgr) const;
+  // The same without the residual checks (it still throws for too few line pixels): for a look
+  // at the overlay of a fit that would be refused. rejection() says why it would be ("" if not).
+  MirrorFit fitUnchecked(const cv::Mat& bgr) const;
+  std::string rejection(const MirrorFit& fit) const;
 
   // The steps of fit, for tests and tools.
   ImageGeometry estimateImageGeometry(const cv::Mat& bgr) const;
