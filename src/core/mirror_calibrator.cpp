@@ -808,8 +808,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   LineFit full_fit(map, pixels, options_);
   // At the rim the camera sees at least across 40% of the field's width (MSL mirrors see the
   // horizon; NuBot's reach about 10 m).
-  for (LineFit* f : {&coarse_fit, &middle_fit, &full_fit})
-    {
+  for (LineFit* f : {&coarse_fit, &middle_fit, &full_fit}) {
     f->setReach(g.chassis_radius_px + 2, g.mirror_radius_px, 0.4 * field_.width_m);
     f->setCenterPrior(g.center_px, 0.01 * g.mirror_radius_px);
   }
@@ -1042,9 +1041,9 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
     result.tan_rms_m = std::sqrt(sum_tan / static_cast<double>(std::max<size_t>(1, common)));
     result.monotone_rms_m = std::sqrt(sum_mono / static_cast<double>(std::max<size_t>(1, common)));
   }
-  const bool use_mono = options_.profile == "monotone" ||
-                        (options_.profile != "tan" && result.monotone_rms_m < 0.95 * result.tan_rms_m &&
-                         mono_res.inlier_fraction >= tan_res.inlier_fraction - 0.01);
+  const bool use_mono =
+      options_.profile == "monotone" || (options_.profile != "tan" && result.monotone_rms_m < 0.95 * result.tan_rms_m &&
+                                         mono_res.inlier_fraction >= tan_res.inlier_fraction - 0.01);
   result.profile = use_mono ? "monotone" : "tan";
   result.calibration = use_mono ? mono_cal : tan_cal;
   result.pose = use_mono ? mono_pose : tan_pose;
@@ -1057,8 +1056,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
     cv::Mat carpet;
     cv::erode(masks.green, carpet, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
     const std::vector<cv::Point2f> carpet_pixels = maskPixels(carpet, g, 3000, 9u);
-    const std::vector<double> d =
-        lineDistances(map, result.calibration.camera, result.pose, carpet_pixels);
+    const std::vector<double> d = lineDistances(map, result.calibration.camera, result.pose, carpet_pixels);
     size_t on_line = 0, on_floor = 0;
     for (double x : d) {
       on_floor += std::isfinite(x);
@@ -1071,8 +1069,9 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
 
 std::string MirrorCalibrator::rejection(const MirrorFit& fit) const {
   if (fit.carpet_on_lines > options_.max_carpet_on_lines) {
-    return "no fit: " + fixed(100 * fit.carpet_on_lines, 1) + "% of the carpet pixels land on the model's lines (limit " +
-           fixed(100 * options_.max_carpet_on_lines, 1) + "%): wrong field, pose or image?";
+    return "no fit: " + fixed(100 * fit.carpet_on_lines, 1) +
+           "% of the carpet pixels land on the model's lines (limit " + fixed(100 * options_.max_carpet_on_lines, 1) +
+           "%): wrong field, pose or image?";
   }
   if (!(fit.residual.median_m <= options_.max_median_residual_m) ||
       fit.residual.inlier_fraction < options_.min_inlier_fraction) {

@@ -40,8 +40,8 @@ struct MirrorCalibratorOptions {
   double max_median_residual_m = 0.05;
   double min_inlier_fraction = 0.5;
   int min_line_pixels = 150;
-  double inlier_distance_m = 0.08;  // a line pixel this close to a model line is an inlier
-  std::string profile = "auto";  // "tan", "monotone" or "auto": the one with the smaller residual
+  double inlier_distance_m = 0.08;   // a line pixel this close to a model line is an inlier
+  std::string profile = "auto";      // "tan", "monotone" or "auto": the one with the smaller residual
   double max_carpet_on_lines = 0.1;  // fraction of carpet pixels the fit may put on painted lines
 };
 
