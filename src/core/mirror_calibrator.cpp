@@ -678,6 +678,7 @@ ImageGeometry MirrorCalibrator::estimateImageGeometry(const cv::Mat& bgr) const 
       best_score = score;
       g.center_px = c;
       g.chassis_radius_px = 0.5 * std::max(w, h);
+      g.chassis_found = true;
     }
   }
   if (best_score < 0) {
@@ -810,7 +811,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   // horizon; NuBot's reach about 10 m).
   for (LineFit* f : {&coarse_fit, &middle_fit, &full_fit}) {
     f->setReach(g.chassis_radius_px + 2, g.mirror_radius_px, 0.4 * field_.width_m);
-    f->setCenterPrior(g.center_px, 0.01 * g.mirror_radius_px);
+    if (g.chassis_found) f->setCenterPrior(g.center_px, 0.01 * g.mirror_radius_px);
   }
   {
     cv::Mat not_line(bgr.size(), CV_8UC1, cv::Scalar(255));
@@ -1041,29 +1042,32 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
     result.tan_rms_m = std::sqrt(sum_tan / static_cast<double>(std::max<size_t>(1, common)));
     result.monotone_rms_m = std::sqrt(sum_mono / static_cast<double>(std::max<size_t>(1, common)));
   }
+  // Carpet next to the lines must not land on them: a fit that puts carpet on the lines explains
+  // nothing there (a flexible profile can bend a band of the image flat onto a line).
+  cv::Mat carpet;
+  cv::erode(masks.green, carpet, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
+  const std::vector<cv::Point2f> carpet_pixels = maskPixels(carpet, g, 3000, 9u);
+  const auto carpetOnLines = [&](const Calibration& cal, const Pose2D& at) {
+    const std::vector<double> d = lineDistances(map, cal.camera, at, carpet_pixels);
+    size_t on_line = 0, on_floor = 0;
+    for (double x : d) {
+      on_floor += std::isfinite(x);
+      on_line += x <= 0.0;
+    }
+    return on_floor > 0 ? static_cast<double>(on_line) / static_cast<double>(on_floor) : 1.0;
+  };
+  const double tan_carpet = carpetOnLines(tan_cal, tan_pose), mono_carpet = carpetOnLines(mono_cal, mono_pose);
   const bool use_mono =
-      options_.profile == "monotone" || (options_.profile != "tan" && result.monotone_rms_m < 0.95 * result.tan_rms_m &&
-                                         mono_res.inlier_fraction >= tan_res.inlier_fraction - 0.01);
+      options_.profile == "monotone" ||
+      (options_.profile != "tan" && result.monotone_rms_m < 0.95 * result.tan_rms_m &&
+       mono_res.inlier_fraction >= tan_res.inlier_fraction - 0.01 && mono_carpet <= tan_carpet + 0.005);
+  result.carpet_on_lines = use_mono ? mono_carpet : tan_carpet;
   result.profile = use_mono ? "monotone" : "tan";
   result.calibration = use_mono ? mono_cal : tan_cal;
   result.pose = use_mono ? mono_pose : tan_pose;
   result.residual = use_mono ? mono_res : tan_res;
   validateCalibration(result.calibration, "act_calibrate");
 
-  // Carpet next to the lines must not land on them: a fit that puts carpet on the lines as readily
-  // as line pixels explains nothing (a flexible profile can bend any image onto a few lines).
-  {
-    cv::Mat carpet;
-    cv::erode(masks.green, carpet, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
-    const std::vector<cv::Point2f> carpet_pixels = maskPixels(carpet, g, 3000, 9u);
-    const std::vector<double> d = lineDistances(map, result.calibration.camera, result.pose, carpet_pixels);
-    size_t on_line = 0, on_floor = 0;
-    for (double x : d) {
-      on_floor += std::isfinite(x);
-      on_line += x <= 0.0;
-    }
-    result.carpet_on_lines = on_floor > 0 ? static_cast<double>(on_line) / static_cast<double>(on_floor) : 1.0;
-  }
   return result;
 }
 

@@ -41,7 +41,7 @@ const char* const kUsage =
     "                        (default: the monotone one when its residual is 5% smaller)\n"
     "  --max-residual M      reject above this median line-pixel residual (default 0.05 m)\n"
     "  --min-inliers F       reject below this fraction of line pixels within 0.08 m (default 0.5)\n"
-    "  --max-carpet-on-lines F  reject when more of the carpet lands on the model's lines (default 0.1)\n"
+    "  --max-carpet-on-lines F  reject when more of the carpet lands on the model's lines (default 0.03)\n"
     "  --output CAL.yaml     write the calibration (validated first)\n"
     "  --overlay OUT.png     the image with the model's lines (magenta) and the line pixels found\n"
     "  --whites FILE         also measure hand-picked line pixels ('x y' per line, NuBot's whites.txt)\n"
@@ -218,8 +218,9 @@ int main(int argc, char** argv) {
       line_pixels = fit.line_pixels;
       const auto& c = calibration.camera;
       const core::ImageGeometry& g = fit.image_geometry;
-      std::printf("image: mirror centre (%.1f, %.1f) from the chassis, rim %.0f px, chassis %.0f px; %zu line pixels\n",
-                  g.center_px.x(), g.center_px.y(), g.mirror_radius_px, g.chassis_radius_px, fit.line_pixels.size());
+      std::printf("image: mirror centre (%.1f, %.1f) %s, rim %.0f px, chassis %.0f px; %zu line pixels\n",
+                  g.center_px.x(), g.center_px.y(), g.chassis_found ? "from the chassis" : "guessed (no chassis found)",
+                  g.mirror_radius_px, g.chassis_radius_px, fit.line_pixels.size());
       std::printf(
           "profile: %s (RMS to the lines' middles over common inliers: a tan(b r) %.4f m with a = %.3f m, b = %.6f "
           "/px; "

@@ -40,9 +40,9 @@ struct MirrorCalibratorOptions {
   double max_median_residual_m = 0.05;
   double min_inlier_fraction = 0.5;
   int min_line_pixels = 150;
-  double inlier_distance_m = 0.08;   // a line pixel this close to a model line is an inlier
-  std::string profile = "auto";      // "tan", "monotone" or "auto": the one with the smaller residual
-  double max_carpet_on_lines = 0.1;  // fraction of carpet pixels the fit may put on painted lines
+  double inlier_distance_m = 0.08;    // a line pixel this close to a model line is an inlier
+  std::string profile = "auto";       // "tan", "monotone" or "auto": the one with the smaller residual
+  double max_carpet_on_lines = 0.03;  // fraction of carpet pixels the fit may put on painted lines
 };
 
 // Mirror centre and radii as seen in the image (before the line fit).
@@ -50,6 +50,7 @@ struct ImageGeometry {
   Eigen::Vector2d center_px{0.0, 0.0};
   double mirror_radius_px = 0.0;
   double chassis_radius_px = 0.0;
+  bool chassis_found = false;  // centre and chassis radius from the chassis seen (else guessed)
 };
 
 // Distance of line pixels to the field model's lines under a calibration and pose.
