@@ -610,7 +610,9 @@ std::vector<cv::Point2f> maskPixels(const cv::Mat& mask, const ImageGeometry& g,
 // Distances of line pixels to the nearest model line through the contract's exact mapping
 // (OmniCameraModel::computeRay); +inf for a pixel that does not look at the floor.
 std::vector<double> lineDistances(const LineDistanceMap& map, const CameraCalibration& camera, const Pose2D& pose,
-                                  const std::vector<cv::Point2f>& pixels) {
+                                  const std::vector<cv::Point2f>& pixels, const FieldCalibration* field = nullptr,
+                                  std::vector<uint8_t>* on_carpet = nullptr) {
+  if (on_carpet) on_carpet->assign(pixels.size(), 0);
   const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
   const OmniCameraModel exact(camera);  // the file's mapping, as every consumer reads it
   std::vector<double> d;
@@ -624,6 +626,10 @@ std::vector<double> lineDistances(const LineDistanceMap& map, const CameraCalibr
     const double wx = pose.x_m + c * ray.ground_x_m - s * ray.ground_y_m;
     const double wy = pose.y_m + s * ray.ground_x_m + c * ray.ground_y_m;
     d.push_back(map.at(wx, wy, std::numeric_limits<double>::infinity()));
+    if (on_carpet && field) {
+      (*on_carpet)[d.size() - 1] =
+          std::abs(wx) <= field->length_m / 2 + field->margin_m && std::abs(wy) <= field->width_m / 2 + field->margin_m;
+    }
   }
   return d;
 }
@@ -764,15 +770,23 @@ std::vector<cv::Point2f> MirrorCalibrator::findLinePixels(const cv::Mat& bgr, co
 
 LineResidual MirrorCalibrator::residual(const CameraCalibration& camera, const Pose2D& pose,
                                         const std::vector<cv::Point2f>& pixels) const {
-  const std::vector<double> d = lineDistances(LineDistanceMap(field_), camera, pose, pixels);
+  std::vector<uint8_t> on_carpet;
+  const std::vector<double> d = lineDistances(LineDistanceMap(field_), camera, pose, pixels, &field_, &on_carpet);
   LineResidual out;
   out.total = pixels.size();
   size_t inliers = 0;
-  for (double x : d) {
-    out.pixels += std::isfinite(x);
-    inliers += x <= options_.inlier_distance_m;
+  std::vector<double> carpet_d;  // hall clutter that lands beyond the carpet is no field line
+  for (size_t i = 0; i < d.size(); ++i) {
+    out.pixels += std::isfinite(d[i]);
+    inliers += d[i] <= options_.inlier_distance_m;
+    if (on_carpet[i]) carpet_d.push_back(d[i]);
   }
-  out.median_m = median(d);
+  out.on_carpet = carpet_d.size();
+  out.median_m = median(carpet_d);
+  const size_t carpet_inliers = static_cast<size_t>(
+      std::count_if(carpet_d.begin(), carpet_d.end(), [&](double x) { return x <= options_.inlier_distance_m; }));
+  out.carpet_inlier_fraction =
+      carpet_d.empty() ? 0.0 : static_cast<double>(carpet_inliers) / static_cast<double>(carpet_d.size());
   out.inlier_fraction = pixels.empty() ? 0.0 : static_cast<double>(inliers) / static_cast<double>(pixels.size());
   return out;
 }
@@ -1078,11 +1092,12 @@ std::string MirrorCalibrator::rejection(const MirrorFit& fit) const {
            "%): wrong field, pose or image?";
   }
   if (!(fit.residual.median_m <= options_.max_median_residual_m) ||
-      fit.residual.inlier_fraction < options_.min_inlier_fraction) {
+      fit.residual.carpet_inlier_fraction < options_.min_inlier_fraction) {
     return "no fit: median line-pixel residual " + fixed(fit.residual.median_m, 3) + " m (limit " +
-           fixed(options_.max_median_residual_m, 3) + "), inlier fraction " + fixed(fit.residual.inlier_fraction, 2) +
-           " (limit " + fixed(options_.min_inlier_fraction, 2) + ") over " + std::to_string(fit.line_pixels.size()) +
-           " line pixels: wrong field, pose or image?";
+           fixed(options_.max_median_residual_m, 3) + "), inlier fraction " +
+           fixed(fit.residual.carpet_inlier_fraction, 2) + " (limit " + fixed(options_.min_inlier_fraction, 2) +
+           ") over the " + std::to_string(fit.residual.on_carpet) +
+           " line pixels on the carpet: wrong field, pose or image?";
   }
   return "";
 }

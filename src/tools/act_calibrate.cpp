@@ -40,7 +40,8 @@ const char* const kUsage =
     "  --profile P           tan (d = a tan(b r)), monotone (piecewise linear elevation) or auto\n"
     "                        (default: the monotone one when its residual is 5% smaller)\n"
     "  --max-residual M      reject above this median line-pixel residual (default 0.05 m)\n"
-    "  --min-inliers F       reject below this fraction of line pixels within 0.08 m (default 0.5)\n"
+    "  --min-inliers F       reject below this fraction of line pixels on the carpet within 0.08 m\n"
+    "                        (default 0.5)\n"
     "  --max-carpet-on-lines F  reject when more of the carpet lands on the model's lines (default 0.03)\n"
     "  --output CAL.yaml     write the calibration (validated first)\n"
     "  --overlay OUT.png     the image with the model's lines (magenta) and the line pixels found\n"
@@ -81,8 +82,10 @@ std::vector<cv::Point2f> readWhites(const std::string& path) {
 }
 
 void printResidual(const std::string& what, const core::LineResidual& r) {
-  std::printf("%s: median %.3f m to the model's lines, inliers (<= 0.08 m) %.3f, %zu of %zu pixels on the floor\n",
-              what.c_str(), r.median_m, r.inlier_fraction, r.pixels, r.total);
+  std::printf(
+      "%s: median %.3f m to the model's lines and inliers (<= 0.08 m) %.3f of the %zu on the carpet; inliers %.3f of "
+      "all %zu, %zu on the floor\n",
+      what.c_str(), r.median_m, r.carpet_inlier_fraction, r.on_carpet, r.inlier_fraction, r.total, r.pixels);
 }
 
 }  // namespace

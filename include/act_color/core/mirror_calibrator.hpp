@@ -55,10 +55,14 @@ struct ImageGeometry {
 
 // Distance of line pixels to the field model's lines under a calibration and pose.
 struct LineResidual {
-  size_t pixels = 0;             // line pixels that look at the floor under the calibration
-  size_t total = 0;              // all line pixels given
-  double median_m = 0.0;         // median distance to the nearest model line (off-floor: +inf)
-  double inlier_fraction = 0.0;  // fraction of all line pixels within the inlier distance
+  size_t pixels = 0;     // line pixels that look at the floor under the calibration
+  size_t on_carpet = 0;  // of them, landing on the carpet (field and margin)
+  size_t total = 0;      // all line pixels given
+  // Median distance to the nearest model line of the pixels on the carpet (hall clutter beyond
+  // it is no field line; +inf when none).
+  double median_m = 0.0;
+  double inlier_fraction = 0.0;         // fraction of all line pixels within the inlier distance
+  double carpet_inlier_fraction = 0.0;  // the same of the pixels on the carpet
 };
 
 struct MirrorFit {
