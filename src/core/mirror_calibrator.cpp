@@ -843,10 +843,37 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
 
   const Pose2D& pose = options_.pose;
   std::vector<int> signs = options_.bearing_sign ? std::vector<int>{*options_.bearing_sign} : std::vector<int>{1, -1};
-  // Grid over the bearing (psi = heading + offset), the sign and the a tan(b r) family (its
-  // horizon from inside the mirror to far beyond it), at the image's centre and the rough pose.
-  std::vector<Candidate> grid;
   const double R = g.mirror_radius_px;
+  // Without the chassis the centre is a guess (the image's centre): first a coarse search over
+  // centres 0.15 R around it (bearings every 10 degrees, a few profiles) for the best start.
+  Eigen::Vector2d start_center = g.center_px;
+  if (!g.chassis_found && !options_.center_px) {
+    double best = std::numeric_limits<double>::infinity();
+    const double step = 0.075 * R;
+    for (int i = -2; i <= 2; ++i) {
+      for (int j = -2; j <= 2; ++j) {
+        const Eigen::Vector2d c = g.center_px + step * Eigen::Vector2d(i, j);
+        for (int sign : signs) {
+          Model model;
+          model.sign = sign;
+          model.height_m = options_.height_m;
+          for (double a : {0.8, 1.8, 4.0}) {
+            for (double rh : {0.9, 1.2, 1.8}) {
+              for (int k = 0; k < 36; ++k) {
+                Eigen::VectorXd p(7);
+                p << c.x(), c.y(), k * kPi / 18, pose.x_m, pose.y_m, std::log(a), std::log(rh * R);
+                const double cost = coarse_fit.cost(model, p, 0.3);
+                if (cost < best) best = cost, start_center = c;
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  // Grid over the bearing (psi = heading + offset), the sign and the a tan(b r) family (its
+  // horizon from inside the mirror to far beyond it), at the start centre and the rough pose.
+  std::vector<Candidate> grid;
   for (int sign : signs) {
     Model model;
     model.sign = sign;
@@ -860,7 +887,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
             psi = pose.theta_rad + *options_.bearing_offset_rad + off;
           }
           Eigen::VectorXd p(7);
-          p << g.center_px.x(), g.center_px.y(), psi, pose.x_m, pose.y_m, std::log(a), std::log(rh * R);
+          p << start_center.x(), start_center.y(), psi, pose.x_m, pose.y_m, std::log(a), std::log(rh * R);
           grid.push_back({model, p, coarse_fit.cost(model, p, 0.3)});
         }
       }
