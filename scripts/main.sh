@@ -8,7 +8,8 @@
 # act_replay, and prints per-class recall/precision and the cycles each class needed after every
 # light change; the same on a second camera. Last, ACT on a quick subset of the randomized scene
 # family's report split (act_eval: defaults, the paper's algorithm and the fixed-table ceiling side
-# by side; ACT_EVAL_SCENES, default 10, of the 100; the whole split: act_eval --split report).
+# by side; ACT_EVAL_SCENES, default 10, of the 100; the whole split: act_eval --split report), and
+# ACT on the real images of test/data/real (act_real_eval: calibration fitted to each image).
 # Installs what is missing and builds first.
 #   scripts/main.sh            small scenarios (a few dozen frames each, about a minute)
 #   scripts/main.sh --full     full-length scenarios (hundreds of frames each)
@@ -74,3 +75,9 @@ eval_scenes=${ACT_EVAL_SCENES:-10}
 echo
 echo "act_color: the randomized scene family, report split, first $eval_scenes of 100 scenes (act_eval)"
 rosrun act_color act_eval --split report --count "$eval_scenes" 2>/dev/null | sed 's/^/  /'
+
+# Real cameras (issue 12): NuBot's lab images, the calibration fitted to each, ACT before and after
+# five changes of light, the defaults and the paper side by side.
+echo
+echo "act_color: real images (test/data/real): calibration from each image, then ACT (act_real_eval)"
+rosrun act_color act_real_eval --dir "$ACT_ROOT/test/data/real" 2>/dev/null | sed 's/^/  /'

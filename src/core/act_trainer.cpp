@@ -35,6 +35,9 @@ constexpr size_t kChassisAnchorSamples = 192;
 constexpr double kLightChangeSigmas = 0.75;
 constexpr double kLightChangeMinShift = 8.0;
 
+// A channel at or above this value is clipped (see the removal step).
+constexpr uint8_t kClippedValue = 254;
+
 // Pixels the cluster and addition steps fetch ahead of the one they look at.
 constexpr int kSamplesAhead = 16;
 
@@ -640,7 +643,10 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
     if (k >= kNumClasses) continue;
     if (!model_.offField(sample.pixel, transform)) continue;
     ++stats.remove_candidates;
-    if (params_.evidence_removal_ratio > 0) {
+    // A clipped color is no evidence: a saturated line and a saturated window or lamp are the same
+    // color; the paper's rule alone decides about it.
+    const bool clipped = std::max({c[0], c[1], c[2]}) >= kClippedValue;
+    if (params_.evidence_removal_ratio > 0 && !clipped) {
       Evidence& e = evidence(cell);
       e.off_field += static_cast<float>(params_.remove_stride);
       if (e.off_field >= kMinOffFieldSightings * params_.remove_stride &&

@@ -16,11 +16,11 @@ Calibration withoutMask(Calibration c) {
   return c;
 }
 
-// A part of the own robot is long along the radius (a strut, a cable): at least this many times its
-// mean width, and at least this fraction of the imaged ring (chassis to mirror rim).
-constexpr double kMinElongation = 3.0;
+// A part of the own robot is a run of candidates along the radius (a strut, a cable) of at least
+// this fraction of the imaged ring (chassis to mirror rim) ...
 constexpr double kMinRadialFraction = 0.15;
-// Or it touches the chassis (the chassis ring): its inner end within this many pixels of it.
+// ... or lies within this fraction of the ring (plus kChassisTouchPx) outside the chassis.
+constexpr double kChassisRingFraction = 0.03;
 constexpr double kChassisTouchPx = 2.0;
 // A pixel must have been looked at in this fraction of the frames (at least 1).
 constexpr double kMinLookedFraction = 0.3;
@@ -76,34 +76,35 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
         candidates.at<uint8_t>(v, u) = 1;
     }
   }
-  // The parts the own robot makes, by their shape about the mirror axis.
-  cv::Mat labels;
-  const int parts = cv::connectedComponents(candidates, labels, 8, CV_32S);
+  // The parts the own robot makes, by their shape about the mirror axis: a strut or a cable is a
+  // long radial run of candidates (a robot or a person on the field, or the edge of a carpet that
+  // is a little smaller than the model's, makes short runs along the radius); the chassis ring
+  // lies right outside the chassis.
   const CameraCalibration& cal = calibration_.camera;
-  std::vector<double> r_min(parts, std::numeric_limits<double>::infinity()), r_max(parts, 0.0);
-  std::vector<double> count(parts, 0.0);
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
-      const int p = labels.at<int>(v, u);
-      if (p == 0) continue;
-      const double r = std::hypot(u - cal.center_u, v - cal.center_v);
-      r_min[p] = std::min(r_min[p], r);
-      r_max[p] = std::max(r_max[p], r);
-      count[p] += 1;
-    }
-  }
   const double ring = std::max(1.0, cal.mirror_radius_px - cal.chassis_radius_px);
-  std::vector<uint8_t> own(parts, 0);
-  for (int p = 1; p < parts; ++p) {
-    const double length = r_max[p] - r_min[p] + 1;
-    const double mean_width = count[p] / length;
-    const bool strut = length >= kMinElongation * mean_width && length >= kMinRadialFraction * ring;
-    const bool chassis_ring = r_min[p] <= cal.chassis_radius_px + kChassisTouchPx;
-    own[p] = strut || chassis_ring;
-  }
+  const double min_run = kMinRadialFraction * ring;
+  const double chassis_ring = cal.chassis_radius_px + kChassisRingFraction * ring + kChassisTouchPx;
+  auto candidate = [&](double u, double v) {
+    const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
+    return iu >= 0 && iv >= 0 && iu < width && iv < height && candidates.at<uint8_t>(iv, iu) != 0;
+  };
   cv::Mat mask(height, width, CV_8UC1, cv::Scalar(0));
   for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) mask.at<uint8_t>(v, u) = own[labels.at<int>(v, u)] ? 255 : 0;
+    for (int u = 0; u < width; ++u) {
+      if (!candidates.at<uint8_t>(v, u)) continue;
+      const double du = u - cal.center_u, dv = v - cal.center_v;
+      const double r = std::hypot(du, dv);
+      bool own = r <= chassis_ring;
+      if (!own && r > 0) {
+        // The run of candidates through this pixel along its ray, in steps of one pixel.
+        const double ex = du / r, ey = dv / r;
+        double run = 1;
+        for (double s = 1; run < min_run && candidate(u + s * ex, v + s * ey); ++s) ++run;
+        for (double s = 1; run < min_run && candidate(u - s * ex, v - s * ey); ++s) ++run;
+        own = run >= min_run;
+      }
+      if (own) mask.at<uint8_t>(v, u) = 255;
+    }
   }
   // One pixel more all round: the blurred edges of a strut are neither carpet nor strut.
   cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));

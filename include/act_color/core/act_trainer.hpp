@@ -65,7 +65,10 @@ struct ActParams {
   // show its color in the field as its class (in-field samples x add stride) and off the field
   // (off-field samples x remove_stride). A cell whose off-field count exceeds this many times its
   // in-field count is removed whatever its distance from the cluster: the color is more often
-  // something else than the class (a spot-lit whitish hall floor next to white). 0: off.
+  // something else than the class (a spot-lit whitish hall floor next to white). Clipped colors
+  // (a channel at 254 or 255) count for nothing: a saturated line and a saturated lamp are one
+  // color (on a real image brightened 1.5x the rule took white's saturated cell and lost 80% of the
+  // line pixels). 0: off.
   double evidence_removal_ratio = 3.0;
 
   void validate() const;

@@ -1,0 +1,73 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "act_color/core/act_trainer.hpp"
+#include "act_color/core/mirror_calibrator.hpp"
+
+namespace act_color {
+namespace sim {
+
+// Issue 12, item 4: ACT on real camera images. For one real image: the calibration from
+// core::MirrorCalibrator (what act_calibrate does), then ACT from that image at the fitted pose
+// and variants of it (the paper's brightness+contrast darkening, a gain of 0.5, gamma 1.6, a warm
+// white balance, a 1.5x brightening) as sequences with fresh noise: kFramesBefore frames of the
+// image, then kFramesAfter of the variant.
+struct RealImage {
+  std::string name;
+  cv::Mat bgr;                               // 8-bit, 3 channels, as cv::imread reads it
+  std::vector<cv::Point> whites;             // hand-picked line pixels (NuBot's whites.txt); may be empty
+  core::MirrorCalibratorOptions calibrator;  // the rough pose and hints for the fit
+  core::FieldCalibration field;
+};
+
+constexpr int kRealFramesBefore = 20;
+constexpr int kRealFramesAfter = 40;
+
+// Per frame, under the table after the frame's cycle.
+struct RealFrameFigures {
+  double white_recall = -1;  // of the hand-picked line pixels classified white (-1: none given)
+  double green_recall = 0;   // of the pixels expected carpet inside the outer lines, 3 px from other classes
+  double hall_in_field = 0;  // of the pixels expected off the carpet (3 px from it) classified green or white
+};
+
+struct RealVariantResult {
+  std::string variant;
+  std::string mode;
+  RealFrameFigures before;  // means over the last 10 frames before the change
+  RealFrameFigures after;   // means over the last 10 frames of the sequence
+  // Cycles after the change until white recall stays within 0.05 of its level before (-1: never,
+  // or no hand-picked pixels).
+  int white_recovery_cycles = -1;
+  std::vector<RealFrameFigures> frames;  // every frame's figures
+};
+
+struct RealImageResult {
+  std::string name;
+  bool fitted = false;
+  std::string why;  // when not fitted
+  core::MirrorFit fit;
+  size_t whites = 0;  // hand-picked line pixels inside the image
+  // The own robot's parts learned from the image (core::SelfMaskLearner), row-major.
+  std::vector<uint8_t> self_mask;
+  double self_mask_fraction = 0;
+  std::vector<RealVariantResult> rows;
+};
+
+// The named variants, in order: "gain_0.5", "darken", "gamma_1.6", "warm_white_balance", "brighten".
+const std::vector<std::string>& realImageVariants();
+
+// Runs the suite on one image for each mode (name, ACT parameters).
+RealImageResult evaluateRealImage(const RealImage& image,
+                                  const std::vector<std::pair<std::string, core::ActParams>>& modes, uint32_t seed = 1);
+
+// A markdown table per image, and the issue's checks.
+std::string formatRealImageReport(const std::vector<RealImageResult>& results);
+
+// Reads a whites.txt (`x y` per line); an empty vector when the file is missing.
+std::vector<cv::Point> readWhites(const std::string& path);
+
+}  // namespace sim
+}  // namespace act_color

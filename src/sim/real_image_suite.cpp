@@ -1,0 +1,237 @@
+#include "act_color/sim/real_image_suite.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "act_color/core/expected_class_model.hpp"
+#include "act_color/core/self_mask_learner.hpp"
+#include "act_color/sim/tone_curve.hpp"
+
+namespace act_color {
+namespace sim {
+namespace {
+
+ToneCurve variantCurve(const std::string& name) {
+  if (name == "gain_0.5") return ToneCurve::gain(Eigen::Vector3d::Constant(0.5));
+  if (name == "darken") return ToneCurve::brightnessContrast(0.5, 0.5);  // the paper's darkening
+  if (name == "gamma_1.6") return ToneCurve::gamma(1.6);
+  if (name == "warm_white_balance") return ToneCurve::whiteBalance(-2000.0);
+  return ToneCurve::gain(Eigen::Vector3d::Constant(1.5));  // "brighten"
+}
+
+// Sensor noise of a real camera, fresh in every frame: Gaussian, 2 DN.
+constexpr double kNoiseDn = 2.0;
+// Pixels this close to another expected class do not count for green recall or for the hall.
+constexpr int kMarginPx = 3;
+// Frames the "before" and "after" figures are averaged over.
+constexpr int kAveragedFrames = 10;
+
+// Pixels expected `k` whose (2 kMarginPx + 1)^2 neighbourhood is all expected `k`.
+std::vector<int> interiorPixels(const cv::Mat& expected, uint8_t k, int step) {
+  cv::Mat is_k = expected == k;
+  cv::erode(is_k, is_k, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kMarginPx + 1, 2 * kMarginPx + 1)));
+  std::vector<int> out;
+  for (int v = 0; v < is_k.rows; v += step) {
+    for (int u = 0; u < is_k.cols; u += step) {
+      if (is_k.at<uint8_t>(v, u)) out.push_back(v * is_k.cols + u);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+const std::vector<std::string>& realImageVariants() {
+  static const std::vector<std::string> names = {"gain_0.5", "darken", "gamma_1.6", "warm_white_balance", "brighten"};
+  return names;
+}
+
+std::vector<cv::Point> readWhites(const std::string& path) {
+  std::vector<cv::Point> out;
+  std::ifstream in(path);
+  int x = 0, y = 0;
+  while (in >> x >> y) out.emplace_back(x, y);
+  return out;
+}
+
+RealImageResult evaluateRealImage(const RealImage& image,
+                                  const std::vector<std::pair<std::string, core::ActParams>>& modes, uint32_t seed) {
+  RealImageResult result;
+  result.name = image.name;
+  try {
+    result.fit = core::MirrorCalibrator(image.field, image.calibrator).fit(image.bgr);
+    result.fitted = true;
+  } catch (const std::exception& e) {
+    result.why = e.what();
+    return result;
+  }
+  core::Calibration cal = result.fit.calibration;
+  const core::Pose2D pose = result.fit.pose;
+  cv::Mat rgb;
+  cv::cvtColor(image.bgr, rgb, cv::COLOR_BGR2RGB);
+  // The own robot's parts (item 3) from this one image: ACT's start-up table at the fitted pose,
+  // then the pixels that show neither carpet nor line where the pose expects one, in the shape of
+  // a strut or touching the chassis. They train nothing and are left out of the figures.
+  {
+    core::ActTrainer trainer(cal);
+    const core::ImageView view = core::ImageView::fromMat(rgb, core::PixelFormat::kRgb8);
+    trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles);
+    core::SelfMaskLearner learner(cal);
+    learner.add(view, pose, trainer.lut());
+    cal.camera.self_mask = learner.mask();
+    cal.camera.self_mask_file = "self_mask.png";
+    size_t masked = 0;
+    for (const uint8_t m : cal.camera.self_mask) masked += m;
+    result.self_mask_fraction = static_cast<double>(masked) / cal.camera.self_mask.size();
+    result.self_mask = cal.camera.self_mask;
+  }
+  // Expected classes at the fitted pose (without eq. 1: the geometry alone).
+  const core::ExpectedClassModel model(cal);
+  const core::PoseTransform transform(pose);
+  cv::Mat expected(rgb.rows, rgb.cols, CV_8UC1);
+  for (int v = 0; v < rgb.rows; ++v) {
+    for (int u = 0; u < rgb.cols; ++u) {
+      expected.at<uint8_t>(v, u) = model.geometricClass(static_cast<size_t>(v) * rgb.cols + u, transform);
+    }
+  }
+  // Green recall inside the field proper (within the outer lines: the margin's width is not known
+  // for a lab field, and there the carpet may end before the model's does).
+  cv::Mat field_carpet = expected.clone();
+  const core::FieldCalibration& f = cal.field;
+  for (int v = 0; v < rgb.rows; ++v) {
+    for (int u = 0; u < rgb.cols; ++u) {
+      const core::PixelRay& ray = model.camera().ray(u, v);
+      if (field_carpet.at<uint8_t>(v, u) != core::kGreen || ray.region != core::PixelRegion::kFloor) continue;
+      double fx, fy;
+      transform.apply(ray.ground_x_m, ray.ground_y_m, &fx, &fy);
+      if (std::abs(fx) > f.length_m / 2 || std::abs(fy) > f.width_m / 2)
+        field_carpet.at<uint8_t>(v, u) = core::kUnknown;
+    }
+  }
+  const std::vector<int> carpet = interiorPixels(field_carpet, core::kGreen, 2);
+  const std::vector<int> hall = interiorPixels(expected, core::kUnknown, 2);
+  std::vector<cv::Point> whites;
+  for (const cv::Point& p : image.whites) {
+    if (p.x >= 0 && p.y >= 0 && p.x < rgb.cols && p.y < rgb.rows) whites.push_back(p);
+  }
+  result.whites = whites.size();
+
+  for (const std::string& variant : realImageVariants()) {
+    const ToneCurve curve = variantCurve(variant);
+    cv::Mat changed = rgb.clone();
+    curve.apply(changed);
+    for (const auto& [mode_name, params] : modes) {
+      core::ActTrainer trainer(cal, params);
+      cv::RNG rng(seed);
+      std::vector<RealFrameFigures> figures;
+      for (int f = 0; f < kRealFramesBefore + kRealFramesAfter; ++f) {
+        cv::Mat frame = (f < kRealFramesBefore ? rgb : changed).clone();
+        cv::Mat noise(frame.size(), CV_16SC3);
+        rng.fill(noise, cv::RNG::NORMAL, 0.0, kNoiseDn);
+        cv::Mat noisy;
+        frame.convertTo(noisy, CV_16SC3);
+        noisy += noise;
+        noisy.convertTo(frame, CV_8UC3);  // saturates
+        const core::ImageView view = core::ImageView::fromMat(frame, core::PixelFormat::kRgb8);
+        if (f == 0) trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles - 1);
+        trainer.cycle(view, pose);
+        const core::ColorLut& lut = trainer.lut();
+        auto classOf = [&](int index) {
+          const cv::Vec3b c = frame.at<cv::Vec3b>(index / frame.cols, index % frame.cols);
+          return lut.classOf(c[0], c[1], c[2]);
+        };
+        RealFrameFigures fig;
+        if (!whites.empty()) {
+          size_t white = 0;
+          for (const cv::Point& p : whites) white += classOf(p.y * frame.cols + p.x) == core::kWhite;
+          fig.white_recall = static_cast<double>(white) / whites.size();
+        }
+        size_t green = 0, in_field = 0;
+        for (const int i : carpet) green += classOf(i) == core::kGreen;
+        for (const int i : hall) {
+          const uint8_t k = classOf(i);
+          in_field += k == core::kGreen || k == core::kWhite;
+        }
+        fig.green_recall = carpet.empty() ? 0.0 : static_cast<double>(green) / carpet.size();
+        fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
+        figures.push_back(fig);
+      }
+      auto mean = [&](int first, int count) {
+        RealFrameFigures m;
+        m.white_recall = 0;
+        for (int f = first; f < first + count; ++f) {
+          m.white_recall += figures[f].white_recall;
+          m.green_recall += figures[f].green_recall;
+          m.hall_in_field += figures[f].hall_in_field;
+        }
+        m.white_recall /= count;
+        m.green_recall /= count;
+        m.hall_in_field /= count;
+        if (whites.empty()) m.white_recall = -1;
+        return m;
+      };
+      RealVariantResult row;
+      row.variant = variant;
+      row.mode = mode_name;
+      row.before = mean(kRealFramesBefore - kAveragedFrames, kAveragedFrames);
+      row.after = mean(kRealFramesBefore + kRealFramesAfter - kAveragedFrames, kAveragedFrames);
+      if (!whites.empty()) {
+        int last_below = -1;
+        for (int f = kRealFramesBefore; f < kRealFramesBefore + kRealFramesAfter; ++f) {
+          if (figures[f].white_recall < row.before.white_recall - 0.05) last_below = f - kRealFramesBefore;
+        }
+        const int cycles = last_below + 2;  // the first frame of the change is cycle 1
+        row.white_recovery_cycles = last_below == kRealFramesAfter - 1 ? -1 : cycles;
+      }
+      row.frames = figures;
+      result.rows.push_back(row);
+    }
+  }
+  return result;
+}
+
+std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
+  std::ostringstream out;
+  char line[512];
+  for (const RealImageResult& r : results) {
+    if (!r.fitted) {
+      out << r.name << ": not fitted (" << r.why << ")\n\n";
+      continue;
+    }
+    std::snprintf(line, sizeof(line),
+                  "%s: %s profile, residual %.3f m, pose (%.2f, %.2f, %.1f deg), %zu hand-picked white pixels, "
+                  "self mask %.1f%% of the image\n\n",
+                  r.name.c_str(), r.fit.profile.c_str(), r.fit.residual.median_m, r.fit.pose.x_m, r.fit.pose.y_m,
+                  r.fit.pose.theta_rad * 180.0 / M_PI, r.whites, 100.0 * r.self_mask_fraction);
+    out << line;
+    out << "| variant | mode | white before / after | white back in | green before / after | hall in a field class "
+           "before / after |\n|---|---|---|---|---|---|\n";
+    for (const RealVariantResult& row : r.rows) {
+      char white[64], back[32];
+      if (row.before.white_recall < 0) {
+        std::snprintf(white, sizeof(white), "-");
+        std::snprintf(back, sizeof(back), "-");
+      } else {
+        std::snprintf(white, sizeof(white), "%.2f / %.2f", row.before.white_recall, row.after.white_recall);
+        if (row.white_recovery_cycles < 0) {
+          std::snprintf(back, sizeof(back), "never");
+        } else {
+          std::snprintf(back, sizeof(back), "%d", row.white_recovery_cycles);
+        }
+      }
+      std::snprintf(line, sizeof(line), "| %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f |\n", row.variant.c_str(),
+                    row.mode.c_str(), white, back, row.before.green_recall, row.after.green_recall,
+                    row.before.hall_in_field, row.after.hall_in_field);
+      out << line;
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace sim
+}  // namespace act_color

@@ -1,0 +1,104 @@
+// act_real_eval: ACT on real camera images (issue 12, item 4). For every folder given (or every
+// folder of --dir) with an image (pic_save0.png) and, optionally, hand-picked line pixels
+// (whites.txt): the camera calibration fitted to the image (as act_calibrate does), then ACT from
+// that image at the fitted pose, and the image under five changes of light as 60-frame sequences
+// with fresh noise, for the defaults and the paper side by side.
+#include <dirent.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "act_color/sim/real_image_suite.hpp"
+
+namespace {
+
+void printUsage(std::ostream& out) {
+  out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007]\n"
+         "  --dir DIR      every folder of DIR that holds the image\n"
+         "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
+         "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
+         "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n";
+}
+
+bool isFile(const std::string& path) {
+  struct stat st {};
+  return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> folders;
+  std::string dir, image_name = "pic_save0.png", preset = "lab6x4";
+  try {
+    for (int i = 1; i < argc; ++i) {
+      const std::string arg = argv[i];
+      auto value = [&]() -> std::string {
+        if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
+        return argv[++i];
+      };
+      if (arg == "--help" || arg == "-h") {
+        printUsage(std::cout);
+        return 0;
+      } else if (arg == "--dir") {
+        dir = value();
+      } else if (arg == "--image") {
+        image_name = value();
+      } else if (arg == "--preset") {
+        preset = value();
+      } else if (!arg.empty() && arg[0] == '-') {
+        throw std::invalid_argument("unknown option " + arg);
+      } else {
+        folders.push_back(arg);
+      }
+    }
+    if (!dir.empty()) {
+      DIR* d = opendir(dir.c_str());
+      if (!d) throw std::invalid_argument(dir + ": cannot be read");
+      std::vector<std::string> names;
+      while (dirent* e = readdir(d)) {
+        const std::string name = e->d_name;
+        if (name != "." && name != ".." && isFile(dir + "/" + name + "/" + image_name)) names.push_back(name);
+      }
+      closedir(d);
+      std::sort(names.begin(), names.end());
+      for (const auto& n : names) folders.push_back(dir + "/" + n);
+    }
+    if (folders.empty()) throw std::invalid_argument("no folder with " + image_name);
+  } catch (const std::exception& e) {
+    std::cerr << "act_real_eval: " << e.what() << "\n";
+    printUsage(std::cerr);
+    return 2;
+  }
+
+  using act_color::core::ActParams;
+  const std::vector<std::pair<std::string, ActParams>> modes = {{"defaults", ActParams()},
+                                                                {"paper", ActParams::paper()}};
+  std::vector<act_color::sim::RealImageResult> results;
+  for (const std::string& folder : folders) {
+    act_color::sim::RealImage image;
+    const size_t slash = folder.find_last_of('/');
+    image.name = (slash == std::string::npos ? folder : folder.substr(slash + 1)) + "/" + image_name;
+    image.bgr = cv::imread(folder + "/" + image_name, cv::IMREAD_COLOR);
+    if (image.bgr.empty()) {
+      std::cerr << "act_real_eval: " << folder << "/" << image_name << ": cannot be read\n";
+      return 1;
+    }
+    image.whites = act_color::sim::readWhites(folder + "/whites.txt");
+    try {
+      image.field = act_color::core::fieldPreset(preset);
+    } catch (const std::exception& e) {
+      std::cerr << "act_real_eval: " << e.what() << "\n";
+      return 2;
+    }
+    results.push_back(act_color::sim::evaluateRealImage(image, modes));
+    std::cerr << "act_real_eval: " << image.name << " done\n";
+  }
+  std::cout << act_color::sim::formatRealImageReport(results);
+  return 0;
+}
