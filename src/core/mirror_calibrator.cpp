@@ -592,8 +592,8 @@ double goalAgreement(const Model& model, const Eigen::VectorXd& p, const std::ve
 
 // The mirror rim seen from `center`: going outwards from the farthest ring with carpet in a fifth
 // of it, the first ring that is mostly dark (the housing); else the image border nearest to the
-// centre. Rings cut by the image border count their pixels inside it.
-double rimRadius(const ColorMasks& masks, const Eigen::Vector2d& center) {
+// centre. With `beyond_border`, rings cut by the image border count (their pixels inside it).
+double rimRadius(const ColorMasks& masks, const Eigen::Vector2d& center, bool beyond_border) {
   const int cols = masks.luma.cols, rows = masks.luma.rows;
   const double r_border = std::min({center.x(), cols - 1 - center.x(), center.y(), rows - 1 - center.y()});
   const double r_corner =
@@ -622,7 +622,7 @@ double rimRadius(const ColorMasks& masks, const Eigen::Vector2d& center) {
   for (int r = 0; r < bins; ++r) {
     if (count[r] > 0 && green[r] > 0.2 * count[r]) r_floor = r;
   }
-  for (int r = r_floor; r < bins; ++r) {
+  for (int r = r_floor; r < bins && (beyond_border || r < r_border); ++r) {
     if (count[r] > 20 && dark[r] > 0.6 * count[r]) return r;
   }
   return r_border;
@@ -733,7 +733,9 @@ ImageGeometry MirrorCalibrator::estimateImageGeometry(const cv::Mat& bgr) const 
   if (options_.center_px) g.center_px = *options_.center_px;
   if (options_.chassis_radius_px) g.chassis_radius_px = *options_.chassis_radius_px;
 
-  const double rim = rimRadius(masks, g.center_px);
+  // Rings cut by the image border only from a centre seen: from a guessed one they would reach
+  // into the housing.
+  const double rim = rimRadius(masks, g.center_px, g.chassis_found);
   g.mirror_radius_px = std::max(rim - 2.0, g.chassis_radius_px + 10);
   if (options_.mirror_radius_px) g.mirror_radius_px = *options_.mirror_radius_px;
   return g;
@@ -1000,7 +1002,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   ImageGeometry fitted_geometry = g;
   if (!g.chassis_found && !options_.mirror_radius_px) {
     fitted_geometry.mirror_radius_px =
-        std::max(rimRadius(masks, Eigen::Vector2d(tan.p[0], tan.p[1])) - 2.0, g.chassis_radius_px + 10);
+        std::max(rimRadius(masks, Eigen::Vector2d(tan.p[0], tan.p[1]), true) - 2.0, g.chassis_radius_px + 10);
   }
   std::vector<double> radii;
   for (const cv::Point2f& px : pixels) radii.push_back(std::hypot(px.x - tan.p[0], px.y - tan.p[1]));
