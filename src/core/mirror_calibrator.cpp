@@ -318,8 +318,6 @@ class LineFit {
     center_sigma_px_ = sigma_px;
   }
 
-  size_t size() const { return pixels_.size(); }
-
   // The other direction: the fraction of the model's line points (within the radii where line
   // pixels were found) that land on a line pixel. Without it, a fit could map every pixel onto
   // one line (a collapsed or flattened profile) at no cost.
@@ -360,8 +358,7 @@ class LineFit {
   double center_sigma_px_ = 1e9;
   cv::Mat pixel_distance_px_;
   double cover_r_min_ = 0, cover_r_max_ = 0;
-
- public:
+  // A fully covered field outweighs the data term of a fit whose every pixel is an outlier.
   static constexpr double kCoverageWeight = 1.5;
 };
 
@@ -1120,7 +1117,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   result.calibration = use_mono ? mono_cal : tan_cal;
   result.pose = use_mono ? mono_pose : tan_pose;
   result.residual = use_mono ? mono_res : tan_res;
-  validateCalibration(result.calibration, "act_calibrate");
+  validateCalibration(result.calibration, "fitted calibration");
 
   return result;
 }
