@@ -47,8 +47,9 @@ ColorMasks colorMasks(const cv::Mat& bgr) {
   ColorMasks m;
   cv::Mat hsv;
   cv::cvtColor(bgr, hsv, cv::COLOR_BGR2HSV);  // H in [0, 180)
-  cv::inRange(hsv, cv::Scalar(16, 110, 90), cv::Scalar(34, 255, 255), m.yellow);
-  cv::inRange(hsv, cv::Scalar(100, 110, 50), cv::Scalar(130, 255, 255), m.blue);
+  // Goal panels under lab light are paler than the simulator's boxes (nubot_1_bak_bak's blue: S ~ 90).
+  cv::inRange(hsv, cv::Scalar(16, 90, 90), cv::Scalar(34, 255, 255), m.yellow);
+  cv::inRange(hsv, cv::Scalar(100, 70, 50), cv::Scalar(130, 255, 255), m.blue);
   // White and grey: low saturation (lines under colored light are greyish, not pure white).
   cv::inRange(hsv, cv::Scalar(0, 0, 70), cv::Scalar(180, 95, 255), m.whiteish);
   cv::Mat grey;
@@ -317,8 +318,6 @@ class LineFit {
     center_sigma_px_ = sigma_px;
   }
 
-  size_t size() const { return pixels_.size(); }
-
   // The other direction: the fraction of the model's line points (within the radii where line
   // pixels were found) that land on a line pixel. Without it, a fit could map every pixel onto
   // one line (a collapsed or flattened profile) at no cost.
@@ -359,8 +358,7 @@ class LineFit {
   double center_sigma_px_ = 1e9;
   cv::Mat pixel_distance_px_;
   double cover_r_min_ = 0, cover_r_max_ = 0;
-
- public:
+  // A fully covered field outweighs the data term of a fit whose every pixel is an outlier.
   static constexpr double kCoverageWeight = 1.5;
 };
 
@@ -589,6 +587,44 @@ double goalAgreement(const Model& model, const Eigen::VectorXd& p, const std::ve
   return (agree - disagree) / (agree + disagree + 1.0);
 }
 
+// The mirror rim seen from `center`: going outwards from the farthest ring with carpet in a fifth
+// of it, the first ring that is mostly dark (the housing); else the image border nearest to the
+// centre. With `beyond_border`, rings cut by the image border count (their pixels inside it).
+double rimRadius(const ColorMasks& masks, const Eigen::Vector2d& center, bool beyond_border) {
+  const int cols = masks.luma.cols, rows = masks.luma.rows;
+  const double r_border = std::min({center.x(), cols - 1 - center.x(), center.y(), rows - 1 - center.y()});
+  const double r_corner =
+      std::max({std::hypot(center.x(), center.y()), std::hypot(cols - center.x(), center.y()),
+                std::hypot(center.x(), rows - center.y()), std::hypot(cols - center.x(), rows - center.y())});
+  const int bins = std::max(2, static_cast<int>(r_corner) + 1);
+  std::vector<double> count(bins, 0), dark(bins, 0), green(bins, 0);
+  std::vector<double> floor_luma;
+  for (int v = 0; v < rows; v += 2) {
+    for (int u = 0; u < cols; u += 2) {
+      if (masks.green.at<uint8_t>(v, u)) floor_luma.push_back(masks.luma.at<float>(v, u));
+    }
+  }
+  const double carpet_luma = floor_luma.empty() ? 100.0 : median(floor_luma);
+  const double dark_threshold = std::max(22.0, 0.4 * carpet_luma);
+  for (int v = 0; v < rows; ++v) {
+    for (int u = 0; u < cols; ++u) {
+      const int r = static_cast<int>(std::hypot(u - center.x(), v - center.y()));
+      if (r >= bins) continue;
+      count[r] += 1;
+      dark[r] += masks.luma.at<float>(v, u) < dark_threshold;
+      green[r] += masks.green.at<uint8_t>(v, u) != 0;
+    }
+  }
+  int r_floor = 0;
+  for (int r = 0; r < bins; ++r) {
+    if (count[r] > 0 && green[r] > 0.2 * count[r]) r_floor = r;
+  }
+  for (int r = r_floor; r < bins && (beyond_border || r < r_border); ++r) {
+    if (count[r] > 20 && dark[r] > 0.6 * count[r]) return r;
+  }
+  return r_border;
+}
+
 std::vector<cv::Point2f> maskPixels(const cv::Mat& mask, const ImageGeometry& g, size_t max_count, uint32_t seed) {
   std::vector<cv::Point2f> out;
   for (int v = 0; v < mask.rows; ++v) {
@@ -694,41 +730,9 @@ ImageGeometry MirrorCalibrator::estimateImageGeometry(const cv::Mat& bgr) const 
   if (options_.center_px) g.center_px = *options_.center_px;
   if (options_.chassis_radius_px) g.chassis_radius_px = *options_.chassis_radius_px;
 
-  // The mirror rim: going outwards from the farthest floor-colored ring, the first ring that is
-  // mostly dark (the housing), or the image border.
-  const double r_border =
-      std::min({g.center_px.x(), bgr.cols - 1 - g.center_px.x(), g.center_px.y(), bgr.rows - 1 - g.center_px.y()});
-  const int bins = std::max(2, static_cast<int>(std::hypot(bgr.cols, bgr.rows)));
-  std::vector<double> count(bins, 0), dark(bins, 0), green(bins, 0);
-  std::vector<float> floor_luma;
-  for (int v = 0; v < bgr.rows; ++v) {
-    for (int u = 0; u < bgr.cols; ++u) {
-      if (masks.green.at<uint8_t>(v, u)) floor_luma.push_back(masks.luma.at<float>(v, u));
-    }
-  }
-  const double carpet_luma =
-      floor_luma.empty() ? 100.0 : median(std::vector<double>(floor_luma.begin(), floor_luma.end()));
-  const double dark_threshold = std::max(22.0, 0.4 * carpet_luma);
-  for (int v = 0; v < bgr.rows; ++v) {
-    for (int u = 0; u < bgr.cols; ++u) {
-      const int r = static_cast<int>(std::hypot(u - g.center_px.x(), v - g.center_px.y()));
-      if (r >= bins) continue;
-      count[r] += 1;
-      dark[r] += masks.luma.at<float>(v, u) < dark_threshold;
-      green[r] += masks.green.at<uint8_t>(v, u) != 0;
-    }
-  }
-  int r_floor = 0;  // the outermost ring with carpet in a fifth of it
-  for (int r = 0; r < bins; ++r) {
-    if (count[r] > 0 && green[r] > 0.2 * count[r]) r_floor = r;
-  }
-  double rim = r_border;
-  for (int r = r_floor; r < bins && r < r_border; ++r) {
-    if (count[r] > 0 && dark[r] > 0.6 * count[r]) {
-      rim = r;
-      break;
-    }
-  }
+  // Rings cut by the image border only from a centre seen: from a guessed one they would reach
+  // into the housing.
+  const double rim = rimRadius(masks, g.center_px, g.chassis_found);
   g.mirror_radius_px = std::max(rim - 2.0, g.chassis_radius_px + 10);
   if (options_.mirror_radius_px) g.mirror_radius_px = *options_.mirror_radius_px;
   return g;
@@ -991,11 +995,17 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   tan.p = levenbergMarquardt(full_fit, tan.model, tan.p, 0.08, 40, nullptr);
   tan.p = levenbergMarquardt(full_fit, tan.model, tan.p, 0.05, 40, nullptr);
 
+  // The rim again from the fitted centre when the start was a guess.
+  ImageGeometry fitted_geometry = g;
+  if (!g.chassis_found && !options_.mirror_radius_px) {
+    fitted_geometry.mirror_radius_px =
+        std::max(rimRadius(masks, Eigen::Vector2d(tan.p[0], tan.p[1]), true) - 2.0, g.chassis_radius_px + 10);
+  }
   std::vector<double> radii;
   for (const cv::Point2f& px : pixels) radii.push_back(std::hypot(px.x - tan.p[0], px.y - tan.p[1]));
   std::sort(radii.begin(), radii.end());
   const double r_lo = g.chassis_radius_px + 1.0;  // from the chassis: the smoothness carries the fit inwards
-  const double r_hi = std::min(g.mirror_radius_px, radii[radii.size() - 1 - radii.size() / 200]);
+  const double r_hi = std::min(fitted_geometry.mirror_radius_px, radii[radii.size() - 1 - radii.size() / 200]);
   Candidate mono;
   mono.model = tan.model;
   mono.model.kind = ProfileKind::kMonotone;
@@ -1053,7 +1063,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
       offset = *options_.bearing_offset_rad;
       refined_pose->theta_rad = wrapAngle(c.p[2] - offset);
     }
-    cal->camera = cameraOf(c.model, c.p, g, bgr.cols, bgr.rows, offset);
+    cal->camera = cameraOf(c.model, c.p, fitted_geometry, bgr.cols, bgr.rows, offset);
     cal->field = field_;
     return residual(cal->camera, *refined_pose, pixels);
   };
@@ -1107,7 +1117,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   result.calibration = use_mono ? mono_cal : tan_cal;
   result.pose = use_mono ? mono_pose : tan_pose;
   result.residual = use_mono ? mono_res : tan_res;
-  validateCalibration(result.calibration, "act_calibrate");
+  validateCalibration(result.calibration, "fitted calibration");
 
   return result;
 }

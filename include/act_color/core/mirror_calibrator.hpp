@@ -36,7 +36,8 @@ struct MirrorCalibratorOptions {
   std::optional<int> bearing_sign;           // fixed instead of fitted
   int bearing_sign_prior = 1;                // when the image cannot tell (see above)
   std::optional<double> bearing_offset_rad;  // fixed: the heading is refined instead
-  // Rejection: an image whose fit is worse than this is refused.
+  // Rejection: an image whose fit is worse than this is refused. Residual and inliers count the
+  // line pixels that land on the carpet (field and margin).
   double max_median_residual_m = 0.05;
   double min_inlier_fraction = 0.5;
   int min_line_pixels = 150;
