@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "act_color/core/expected_class_model.hpp"
+#include "act_color/core/segmenter.hpp"
 #include "act_color/core/self_mask_learner.hpp"
 #include "act_color/sim/tone_curve.hpp"
 
@@ -159,6 +160,10 @@ RealImageResult evaluateRealImage(const RealImage& image,
         fig.green_recall = carpet.empty() ? 0.0 : static_cast<double>(green) / carpet.size();
         fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
         figures.push_back(fig);
+        if (result.labels_before.empty() && f == kRealFramesBefore - 1) {
+          result.frame_before = frame.clone();
+          core::Segmenter(cal.camera).classify(lut, view, result.labels_before);
+        }
       }
       auto mean = [&](int first, int count) {
         RealFrameFigures m;

@@ -10,9 +10,11 @@
 #include <cstdio>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
+#include "act_color/core/segmenter.hpp"
 #include "act_color/sim/real_image_suite.hpp"
 
 namespace {
@@ -22,7 +24,8 @@ void printUsage(std::ostream& out) {
          "  --dir DIR      every folder of DIR that holds the image\n"
          "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
-         "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n";
+         "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n"
+         "  --png DIR      each image beside its classes (defaults, the frame before the change) as a PNG\n";
 }
 
 bool isFile(const std::string& path) {
@@ -34,7 +37,7 @@ bool isFile(const std::string& path) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> folders;
-  std::string dir, image_name = "pic_save0.png", preset = "lab6x4";
+  std::string dir, png_dir, image_name = "pic_save0.png", preset = "lab6x4";
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
@@ -51,6 +54,8 @@ int main(int argc, char** argv) {
         image_name = value();
       } else if (arg == "--preset") {
         preset = value();
+      } else if (arg == "--png") {
+        png_dir = value();
       } else if (!arg.empty() && arg[0] == '-') {
         throw std::invalid_argument("unknown option " + arg);
       } else {
@@ -97,6 +102,21 @@ int main(int argc, char** argv) {
       return 2;
     }
     results.push_back(act_color::sim::evaluateRealImage(image, modes));
+    const auto& r = results.back();
+    if (!png_dir.empty() && !r.labels_before.empty()) {
+      cv::Mat bgr, colored, out;
+      cv::cvtColor(r.frame_before, bgr, cv::COLOR_RGB2BGR);
+      act_color::core::colorizeLabels(r.labels_before, colored);
+      cv::cvtColor(colored, colored, cv::COLOR_RGB2BGR);
+      cv::hconcat(bgr, colored, out);
+      std::string file = image.name;
+      std::replace(file.begin(), file.end(), '/', '_');
+      const std::string path = png_dir + "/" + file.substr(0, file.rfind('.')) + "_classified.png";
+      if (!cv::imwrite(path, out)) {
+        std::cerr << "act_real_eval: " << path << ": cannot be written\n";
+        return 1;
+      }
+    }
     std::cerr << "act_real_eval: " << image.name << " done\n";
   }
   std::cout << act_color::sim::formatRealImageReport(results);

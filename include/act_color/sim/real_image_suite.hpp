@@ -53,6 +53,10 @@ struct RealImageResult {
   // The own robot's parts learned from the image (core::SelfMaskLearner), row-major.
   std::vector<uint8_t> self_mask;
   double self_mask_fraction = 0;
+  // The first mode's labels of the last frame before the change (of the first variant), and that
+  // frame (rgb8): a look at a real image classified.
+  cv::Mat frame_before;
+  cv::Mat labels_before;
   std::vector<RealVariantResult> rows;
 };
 
