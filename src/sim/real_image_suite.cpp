@@ -51,6 +51,14 @@ const std::vector<std::string>& realImageVariants() {
   return names;
 }
 
+std::vector<uint8_t> readNubotTable(const std::string& path) {
+  std::vector<uint8_t> table(64 * 64 * 64);
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(reinterpret_cast<char*>(table.data()), static_cast<std::streamsize>(table.size()))) return {};
+  if (in.peek() != std::ifstream::traits_type::eof()) return {};
+  return table;
+}
+
 std::vector<cv::Point> readWhites(const std::string& path) {
   std::vector<cv::Point> out;
   std::ifstream in(path);
@@ -121,10 +129,28 @@ RealImageResult evaluateRealImage(const RealImage& image,
   }
   result.whites = whites.size();
 
+  // NuBot's fixed table: green of the carpet and of the hall (its only field class) on an image.
+  constexpr uint8_t kNubotGreen = 2, kNubotBlack = 1;
+  auto nubotClass = [&](const cv::Mat& image_rgb, int index) {
+    const cv::Vec3b c = image_rgb.at<cv::Vec3b>(index / image_rgb.cols, index % image_rgb.cols);
+    return image.nubot_table[(c[2] / 4) * 4096 + (c[1] / 4) * 64 + c[0] / 4];
+  };
+  auto nubotFigures = [&](const cv::Mat& image_rgb) {
+    RealFrameFigures fig{-1, -1, -1};
+    if (image.nubot_table.empty()) return fig;
+    size_t green = 0, in_field = 0;
+    for (const int i : carpet) green += nubotClass(image_rgb, i) == kNubotGreen;
+    for (const int i : hall) in_field += nubotClass(image_rgb, i) == kNubotGreen;
+    fig.green_recall = carpet.empty() ? 0.0 : static_cast<double>(green) / carpet.size();
+    fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
+    return fig;
+  };
+
   for (const std::string& variant : realImageVariants()) {
     const ToneCurve curve = variantCurve(variant);
     cv::Mat changed = rgb.clone();
     curve.apply(changed);
+    const RealFrameFigures nubot_before = nubotFigures(rgb), nubot_after = nubotFigures(changed);
     for (const auto& [mode_name, params] : modes) {
       core::ActTrainer trainer(cal, params);
       cv::RNG rng(seed);
@@ -163,6 +189,19 @@ RealImageResult evaluateRealImage(const RealImage& image,
         if (result.labels_before.empty() && f == kRealFramesBefore - 1) {
           result.frame_before = frame.clone();
           core::Segmenter(cal.camera).classify(lut, view, result.labels_before);
+          if (!image.nubot_table.empty()) {
+            size_t imaged = 0, green = 0, black = 0;
+            for (int i = 0; i < frame.rows * frame.cols; ++i) {
+              if (expected.at<uint8_t>(i / frame.cols, i % frame.cols) == core::kNotImaged) continue;
+              const uint8_t ours = result.labels_before.at<uint8_t>(i / frame.cols, i % frame.cols);
+              const uint8_t theirs = nubotClass(frame, i);
+              ++imaged;
+              green += (ours == core::kGreen) == (theirs == kNubotGreen);
+              black += (ours == core::kBlack) == (theirs == kNubotBlack);
+            }
+            result.nubot_green_agreement = imaged ? static_cast<double>(green) / imaged : 0.0;
+            result.nubot_black_agreement = imaged ? static_cast<double>(black) / imaged : 0.0;
+          }
         }
       }
       auto mean = [&](int first, int count) {
@@ -193,6 +232,8 @@ RealImageResult evaluateRealImage(const RealImage& image,
         row.white_recovery_cycles = last_below == kRealFramesAfter - 1 ? -1 : cycles;
       }
       row.frames = figures;
+      row.nubot_before = nubot_before;
+      row.nubot_after = nubot_after;
       result.rows.push_back(row);
     }
   }
@@ -213,9 +254,17 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
                   r.name.c_str(), r.fit.profile.c_str(), r.fit.residual.median_m, r.fit.pose.x_m, r.fit.pose.y_m,
                   r.fit.pose.theta_rad * 180.0 / M_PI, r.whites, 100.0 * r.self_mask_fraction);
     out << line;
+    if (r.nubot_green_agreement >= 0) {
+      std::snprintf(line, sizeof(line),
+                    "NuBot's hand-made table (CTableBGR.dat): agrees with ACT's on green in %.0f%% and on black in "
+                    "%.0f%% of the imaged pixels (defaults, last frame before the change)\n\n",
+                    100.0 * r.nubot_green_agreement, 100.0 * r.nubot_black_agreement);
+      out << line;
+    }
     out << "| variant | mode | white before / after | white back in | green before / after | hall in a field class "
            "before / after |\n|---|---|---|---|---|---|\n";
-    for (const RealVariantResult& row : r.rows) {
+    for (size_t n = 0; n < r.rows.size(); ++n) {
+      const RealVariantResult& row = r.rows[n];
       char white[64], back[32];
       if (row.before.white_recall < 0) {
         std::snprintf(white, sizeof(white), "-");
@@ -232,6 +281,13 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
                     row.mode.c_str(), white, back, row.before.green_recall, row.after.green_recall,
                     row.before.hall_in_field, row.after.hall_in_field);
       out << line;
+      const bool last_of_variant = n + 1 == r.rows.size() || r.rows[n + 1].variant != row.variant;
+      if (last_of_variant && row.nubot_before.green_recall >= 0) {
+        std::snprintf(line, sizeof(line), "| %s | NuBot's table | - | - | %.2f / %.2f | %.2f / %.2f (green) |\n",
+                      row.variant.c_str(), row.nubot_before.green_recall, row.nubot_after.green_recall,
+                      row.nubot_before.hall_in_field, row.nubot_after.hall_in_field);
+        out << line;
+      }
     }
     out << "\n";
   }

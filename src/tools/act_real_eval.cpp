@@ -23,6 +23,7 @@ void printUsage(std::ostream& out) {
   out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007]\n"
          "  --dir DIR      every folder of DIR that holds the image\n"
          "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
+         "                 and CTableBGR.dat (NuBot's hand-made table, compared with ACT's)\n"
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
          "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n"
          "  --png DIR      each image beside its classes (defaults, the frame before the change) as a PNG\n";
@@ -95,6 +96,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     image.whites = act_color::sim::readWhites(folder + "/whites.txt");
+    image.nubot_table = act_color::sim::readNubotTable(folder + "/CTableBGR.dat");
     try {
       image.field = act_color::core::fieldPreset(preset);
     } catch (const std::exception& e) {

@@ -20,6 +20,10 @@ struct RealImage {
   cv::Mat bgr;                               // 8-bit, 3 channels, as cv::imread reads it
   std::vector<cv::Point> whites;             // hand-picked line pixels (NuBot's whites.txt); may be empty
   core::MirrorCalibratorOptions calibrator;  // the rough pose and hints for the fit
+  // NuBot's hand-made table of the folder (CTableBGR.dat: 64^3 cells indexed B/4, G/4, R/4; classes
+  // 0 ball, 1 black, 2 green, 3 unknown; no white: their lines are found by brightness); empty when
+  // there is none.
+  std::vector<uint8_t> nubot_table;
   core::FieldCalibration field;
 };
 
@@ -42,6 +46,9 @@ struct RealVariantResult {
   // or no hand-picked pixels).
   int white_recovery_cycles = -1;
   std::vector<RealFrameFigures> frames;  // every frame's figures
+  // NuBot's fixed table on the image and on the changed image (white_recall unused; -1: no table).
+  RealFrameFigures nubot_before{-1, -1, -1};
+  RealFrameFigures nubot_after{-1, -1, -1};
 };
 
 struct RealImageResult {
@@ -57,6 +64,10 @@ struct RealImageResult {
   // frame (rgb8): a look at a real image classified.
   cv::Mat frame_before;
   cv::Mat labels_before;
+  // Of the imaged pixels, the fraction where NuBot's table and ours agree on green (green in both
+  // or in neither) and on black, on that frame (-1: no table).
+  double nubot_green_agreement = -1;
+  double nubot_black_agreement = -1;
   std::vector<RealVariantResult> rows;
 };
 
@@ -69,6 +80,9 @@ RealImageResult evaluateRealImage(const RealImage& image,
 
 // A markdown table per image, and the checks.
 std::string formatRealImageReport(const std::vector<RealImageResult>& results);
+
+// Reads a NuBot table (64^3 bytes); an empty vector when the file is missing or not that size.
+std::vector<uint8_t> readNubotTable(const std::string& path);
 
 // Reads a whites.txt (`x y` per line); an empty vector when the file is missing.
 std::vector<cv::Point> readWhites(const std::string& path);
