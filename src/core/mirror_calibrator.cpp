@@ -1256,6 +1256,24 @@ double requireNumber(const std::string& text, const std::string& path, const std
 
 }  // namespace
 
+std::vector<cv::Point2f> readNubotWhites(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw std::runtime_error(path + ": cannot be read");
+  std::vector<cv::Point2f> out;
+  double x, y;
+  while (file >> x >> y) out.emplace_back(static_cast<float>(x), static_cast<float>(y));
+  if (out.empty()) throw std::runtime_error(path + ": no 'x y' pixels");
+  return out;
+}
+
+ImageGeometry imageGeometryOf(const CameraCalibration& camera) {
+  ImageGeometry g;
+  g.center_px = {camera.center_u, camera.center_v};
+  g.chassis_radius_px = camera.chassis_radius_px;
+  g.mirror_radius_px = camera.mirror_radius_px;
+  return g;
+}
+
 CameraCalibration importNubotMirror(const std::string& mirror_xml_path, const std::string& roi_xml_path, int width,
                                     int height, double height_m) {
   const std::string text = readText(mirror_xml_path);

@@ -59,14 +59,6 @@ std::vector<uint8_t> readNubotTable(const std::string& path) {
   return table;
 }
 
-std::vector<cv::Point> readWhites(const std::string& path) {
-  std::vector<cv::Point> out;
-  std::ifstream in(path);
-  int x = 0, y = 0;
-  while (in >> x >> y) out.emplace_back(x, y);
-  return out;
-}
-
 RealImageResult evaluateRealImage(const RealImage& image,
                                   const std::vector<std::pair<std::string, core::ActParams>>& modes, uint32_t seed) {
   RealImageResult result;
@@ -93,9 +85,6 @@ RealImageResult evaluateRealImage(const RealImage& image,
     learner.add(view, pose, trainer.lut());
     cal.camera.self_mask = learner.mask();
     cal.camera.self_mask_file = "self_mask.png";
-    size_t masked = 0;
-    for (const uint8_t m : cal.camera.self_mask) masked += m;
-    result.self_mask_fraction = static_cast<double>(masked) / cal.camera.self_mask.size();
     result.self_mask = cal.camera.self_mask;
   }
   // Expected classes at the fitted pose (without eq. 1: the geometry alone).
@@ -123,9 +112,10 @@ RealImageResult evaluateRealImage(const RealImage& image,
   }
   const std::vector<int> carpet = interiorPixels(field_carpet, core::kGreen, 2);
   const std::vector<int> hall = interiorPixels(expected, core::kUnknown, 2);
-  std::vector<cv::Point> whites;
-  for (const cv::Point& p : image.whites) {
-    if (p.x >= 0 && p.y >= 0 && p.x < rgb.cols && p.y < rgb.rows) whites.push_back(p);
+  std::vector<cv::Point> whites;  // inside the image, as pixel indices
+  for (const cv::Point2f& p : image.whites) {
+    const cv::Point q(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)));
+    if (q.x >= 0 && q.y >= 0 && q.x < rgb.cols && q.y < rgb.rows) whites.push_back(q);
   }
   result.whites = whites.size();
 
@@ -252,7 +242,10 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
                   "%s: %s profile, residual %.3f m, pose (%.2f, %.2f, %.1f deg), %zu hand-picked white pixels, "
                   "self mask %.1f%% of the image\n\n",
                   r.name.c_str(), r.fit.profile.c_str(), r.fit.residual.median_m, r.fit.pose.x_m, r.fit.pose.y_m,
-                  r.fit.pose.theta_rad * 180.0 / M_PI, r.whites, 100.0 * r.self_mask_fraction);
+                  r.fit.pose.theta_rad * 180.0 / M_PI, r.whites,
+                  r.self_mask.empty() ? 0.0
+                                      : 100.0 * std::count(r.self_mask.begin(), r.self_mask.end(), uint8_t{1}) /
+                                            static_cast<double>(r.self_mask.size()));
     out << line;
     if (r.nubot_green_agreement >= 0) {
       std::snprintf(line, sizeof(line),

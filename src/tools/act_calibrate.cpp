@@ -71,16 +71,6 @@ std::vector<double> numbers(const std::string& text, size_t count, const std::st
 
 double number(const std::string& text, const std::string& option) { return numbers(text, 1, option)[0]; }
 
-std::vector<cv::Point2f> readWhites(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw std::runtime_error(path + ": cannot be read");
-  std::vector<cv::Point2f> out;
-  double x, y;
-  while (file >> x >> y) out.emplace_back(static_cast<float>(x), static_cast<float>(y));
-  if (out.empty()) throw std::runtime_error(path + ": no 'x y' pixels");
-  return out;
-}
-
 void printResidual(const std::string& what, const core::LineResidual& r) {
   std::printf(
       "%s: median %.3f m to the model's lines and inliers (<= 0.08 m) %.3f of the %zu on the carpet; inliers %.3f of "
@@ -191,11 +181,7 @@ int main(int argc, char** argv) {
                                  " but " + check + " is for " + std::to_string(calibration.camera.width) + "x" +
                                  std::to_string(calibration.camera.height));
       }
-      core::ImageGeometry g;
-      g.center_px = {calibration.camera.center_u, calibration.camera.center_v};
-      g.chassis_radius_px = calibration.camera.chassis_radius_px;
-      g.mirror_radius_px = calibration.camera.mirror_radius_px;
-      line_pixels = calibrator.findLinePixels(image, g);
+      line_pixels = calibrator.findLinePixels(image, core::imageGeometryOf(calibration.camera));
       printResidual("line pixels found", calibrator.residual(calibration.camera, pose, line_pixels));
     } else if (!nubot.empty()) {
       int w = size_w, h = size_h;
@@ -206,11 +192,7 @@ int main(int argc, char** argv) {
                   calibration.camera.center_u, calibration.camera.center_v, calibration.camera.elevation_map.size(),
                   calibration.camera.mirror_radius_px);
       if (!image.empty()) {
-        core::ImageGeometry g;
-        g.center_px = {calibration.camera.center_u, calibration.camera.center_v};
-        g.chassis_radius_px = calibration.camera.chassis_radius_px;
-        g.mirror_radius_px = calibration.camera.mirror_radius_px;
-        line_pixels = calibrator.findLinePixels(image, g);
+        line_pixels = calibrator.findLinePixels(image, core::imageGeometryOf(calibration.camera));
         printResidual("line pixels found", calibrator.residual(calibration.camera, pose, line_pixels));
       }
     } else {
@@ -239,7 +221,7 @@ int main(int argc, char** argv) {
       rejected = calibrator.rejection(fit);
     }
     if (!whites.empty()) {
-      printResidual("whites " + whites, calibrator.residual(calibration.camera, pose, readWhites(whites)));
+      printResidual("whites " + whites, calibrator.residual(calibration.camera, pose, core::readNubotWhites(whites)));
     }
     if (!overlay.empty()) {
       if (image.empty()) return usage("--overlay needs --image");

@@ -95,7 +95,12 @@ int main(int argc, char** argv) {
       std::cerr << "act_real_eval: " << folder << "/" << image_name << ": cannot be read\n";
       return 1;
     }
-    image.whites = act_color::sim::readWhites(folder + "/whites.txt");
+    try {
+      if (isFile(folder + "/whites.txt")) image.whites = act_color::core::readNubotWhites(folder + "/whites.txt");
+    } catch (const std::exception& e) {
+      std::cerr << "act_real_eval: " << e.what() << "\n";
+      return 1;
+    }
     image.nubot_table = act_color::sim::readNubotTable(folder + "/CTableBGR.dat");
     try {
       image.field = act_color::core::fieldPreset(preset);

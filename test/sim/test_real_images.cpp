@@ -18,7 +18,7 @@ sim::RealImageResult run(const std::string& folder) {
   image.name = folder;
   const std::string dir = sim_test::sourcePath("test/data/real/" + folder);
   image.bgr = cv::imread(dir + "/pic_save0.png", cv::IMREAD_COLOR);
-  image.whites = sim::readWhites(dir + "/whites.txt");
+  image.whites = core::readNubotWhites(dir + "/whites.txt");
   image.field = core::fieldPreset("lab6x4");
   EXPECT_FALSE(image.bgr.empty());
   EXPECT_GT(image.whites.size(), 1000u);

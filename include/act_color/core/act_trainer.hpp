@@ -39,7 +39,7 @@ struct ActParams {
   // removed when seen off the field, whatever its distance from the cluster (off-field colors
   // near a class, like a whitish hall floor, do not stay in the class by vicinity alone).
   int add_neighbourhood_cells = 1;
-  // When the carpet's median color jumps beyond one sigma of green (a global change of light or
+  // When the carpet's median color jumps beyond 0.75 sigma of green (a global change of light or
   // of the camera's settings), the per-channel monotone map of colors estimated by LightModel
   // (quantiles of the carpet, line and chassis pixels before and after) moves every cluster and
   // the table, so that all classes follow at once instead of re-learning from sparse samples.

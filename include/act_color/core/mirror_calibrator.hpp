@@ -127,6 +127,13 @@ const std::vector<std::string>& fieldPresetNames();
 // from the model for the given height, up to the mirror radius (ROI.xml's big_radius when given,
 // else the radius where the model reaches the horizon or max_radius). Throws CalibrationError for a
 // missing, malformed or implausible value (e.g. a fit of another model).
+// NuBot's hand-picked white line pixels (whites.txt: `x y`, column and row, per line). Throws
+// std::runtime_error when the file cannot be read or holds no pixel.
+std::vector<cv::Point2f> readNubotWhites(const std::string& path);
+
+// The image geometry a calibration states (centre and radii), e.g. to find line pixels with it.
+ImageGeometry imageGeometryOf(const CameraCalibration& camera);
+
 CameraCalibration importNubotMirror(const std::string& mirror_xml_path, const std::string& roi_xml_path, int width,
                                     int height, double height_m);
 

@@ -18,7 +18,7 @@ namespace sim {
 struct RealImage {
   std::string name;
   cv::Mat bgr;                               // 8-bit, 3 channels, as cv::imread reads it
-  std::vector<cv::Point> whites;             // hand-picked line pixels (NuBot's whites.txt); may be empty
+  std::vector<cv::Point2f> whites;           // hand-picked line pixels (core::readNubotWhites); may be empty
   core::MirrorCalibratorOptions calibrator;  // the rough pose and hints for the fit
   // NuBot's hand-made table of the folder (CTableBGR.dat: 64^3 cells indexed B/4, G/4, R/4; classes
   // 0 ball, 1 black, 2 green, 3 unknown; no white: their lines are found by brightness); empty when
@@ -59,7 +59,6 @@ struct RealImageResult {
   size_t whites = 0;  // hand-picked line pixels inside the image
   // The own robot's parts learned from the image (core::SelfMaskLearner), row-major.
   std::vector<uint8_t> self_mask;
-  double self_mask_fraction = 0;
   // The first mode's labels of the last frame before the change (of the first variant), and that
   // frame (rgb8): a look at a real image classified.
   cv::Mat frame_before;
@@ -83,9 +82,6 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results);
 
 // Reads a NuBot table (64^3 bytes); an empty vector when the file is missing or not that size.
 std::vector<uint8_t> readNubotTable(const std::string& path);
-
-// Reads a whites.txt (`x y` per line); an empty vector when the file is missing.
-std::vector<cv::Point> readWhites(const std::string& path);
 
 }  // namespace sim
 }  // namespace act_color
