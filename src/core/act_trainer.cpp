@@ -35,6 +35,10 @@ constexpr size_t kChassisAnchorSamples = 192;
 constexpr double kLightChangeSigmas = 0.75;
 constexpr double kLightChangeMinShift = 8.0;
 
+// The evidence removal ratio for the ball's colors (at most ActParams::evidence_removal_ratio): a
+// color of the ball seen off the field as often as on it gives more false sightings than true.
+constexpr double kBallEvidenceRatio = 1.0;
+
 // A channel at or above this value is clipped (see the removal step).
 constexpr uint8_t kClippedValue = 254;
 
@@ -106,6 +110,7 @@ void ActParams::validate() const {
   requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
   requireRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
   requireRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
+  requireRange("ball_diameter_m", ball_diameter_m, 0.05, 1.0);
 }
 
 void ActParams::set(const std::string& name, const std::string& value) {
@@ -165,6 +170,10 @@ void ActParams::set(const std::string& name, const std::string& value) {
     nearest_mean = boolean();
   } else if (name == "evidence_removal_ratio") {
     evidence_removal_ratio = number();
+  } else if (name == "ball_training") {
+    ball_training = boolean();
+  } else if (name == "ball_diameter_m") {
+    ball_diameter_m = number();
   } else {
     throw std::invalid_argument("unknown ACT parameter '" + name + "'");
   }
@@ -177,6 +186,7 @@ void ActParams::switchOffExtensions() {
   robots_train_black = false;
   nearest_mean = false;
   evidence_removal_ratio = 0;
+  ball_training = false;
 }
 
 ActParams ActParams::paper() {
@@ -186,7 +196,11 @@ ActParams ActParams::paper() {
 }
 
 ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
-    : model_(calibration), params_(params), lut_(params.lut_bits), rng_(params.seed) {
+    : model_(calibration),
+      params_(params),
+      lut_(params.lut_bits),
+      rng_(params.seed),
+      ball_detector_(model_, 0.5 * params.ball_diameter_m) {
   params_.validate();
   // The chassis is small in the image (a few dozen of the cluster step's samples at most): the
   // light model reads it densely, every n-th of its pixels.
@@ -208,6 +222,8 @@ void ActTrainer::reset(ColorSpace space) {
   evidence_.assign(lut_.size(), Evidence{});
   for (auto& cluster : clusters_) cluster.reset(255.0);
   light_.reset();
+  ball_hypotheses_.clear();
+  ball_last_seen_ = 0;
   space_known_ = true;
 }
 
@@ -220,6 +236,10 @@ void ActTrainer::setParams(const ActParams& params) {
   params_ = params;
   if (seed_changed) rng_.seed(params_.seed);
   if (light_on) light_.reset();
+  if (ball_detector_.radius() != 0.5 * params_.ball_diameter_m) {
+    ball_detector_ = BallDetector(model_, 0.5 * params_.ball_diameter_m);
+    ball_hypotheses_.clear();
+  }
   if (bits_changed) {
     const bool known = space_known_;
     reset(lut_.colorSpace());
@@ -256,6 +276,9 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   if ((cluster.mean() - color).norm() >= radius) return 0;  // 2.3: |mu_k - c| < zeta sigma_k
   uint32_t changed = 0;
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+  // The ball never takes a color of another class (a goal's, the carpet's, a line's, a robot's).
+  const bool subordinate = k == kOrange;
+  if (subordinate && lut_.at(cell) != kUnknown && lut_.at(cell) != kOrange) return 0;
   if (nearerToOtherMean(color, k)) return 0;
   const uint32_t this_cycle = static_cast<uint32_t>(revision_ + 1);
   if (params_.evidence_removal_ratio > 0) {
@@ -266,7 +289,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     const uint8_t current = lut_.at(cell);
     if (current != k && current != kUnknown) e = Evidence{0.f, 0.f, this_cycle};
     e.in_field += static_cast<float>(add_weight_);
-    if (current != k && e.off_field > params_.evidence_removal_ratio * e.in_field) return 0;
+    if (current != k && e.off_field > evidenceRatio(k) * e.in_field) return 0;
   }
   // A cell sampled for k before in this cycle has had its neighbourhood filled with this very
   // cluster: doing it again changes nothing.
@@ -279,7 +302,8 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     setCell(cell, k);
     ++changed;
   }
-  const int n = params_.add_neighbourhood_cells;
+  // The ball is small: the cells around its colors are more often something else's (a hall poster).
+  const int n = subordinate ? 0 : params_.add_neighbourhood_cells;
   if (n == 0) return changed;
   // The neighbourhood of a cell confirmed in the last few cycles was filled with a cluster that
   // has hardly moved since (eta = 4): it is filled again only every kNeighbourhoodRefreshCycles.
@@ -294,7 +318,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
       for (int d = std::max(0, i2 - n); d <= std::min(cells - 1, i2 + n); ++d) {
         const uint32_t neighbour = lut_.cellIndex(a, b, d);
         const uint8_t current = lut_.at(neighbour);
-        if (current == k) continue;
+        if (current == k || (subordinate && current != kUnknown)) continue;
         const Eigen::Vector3d centre((a << shift) + half, (b << shift) + half, (d << shift) + half);
         const double distance = (cluster.mean() - centre).norm();
         if (distance >= radius) continue;
@@ -308,6 +332,10 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     }
   }
   return changed;
+}
+
+double ActTrainer::evidenceRatio(uint8_t k) const {
+  return k == kOrange ? std::min(params_.evidence_removal_ratio, kBallEvidenceRatio) : params_.evidence_removal_ratio;
 }
 
 uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
@@ -342,6 +370,8 @@ void ActTrainer::prepareNearestMean() {
     const Eigen::Vector3d& own = clusters_[k].mean();
     for (int j = 1; j < kNumClasses; ++j) {
       if (j == k || !clusters_[j].trained()) continue;
+      // The goal region decides between a goal and the ball: the ball's mean takes no goal color.
+      if (j == kOrange && (k == kYellow || k == kBlue)) continue;
       const Eigen::Vector3d& other = clusters_[j].mean();
       mean_boundaries_[k].push_back({2.0 * a * (own - other), own.dot(a * own) - other.dot(a * other)});
     }
@@ -417,6 +447,7 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
   // Confirmations were made under the old light: colors of the old light that now show up off the
   // field must not be protected from removal.
   std::fill(confirmed_.begin(), confirmed_.end(), 0u);
+  ball_hypotheses_.clear();  // their colors are the old light's
 }
 
 void ActTrainer::setCell(uint32_t cell, uint8_t k) {
@@ -588,11 +619,13 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     stats.added[trained] += addColor(c, trained);
   });
 
+  model_.sectorSafeRanges(pose, sector_safe_range_);
+  if (params_.ball_training) trainBall(image, stats);
+
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
   const size_t start = randomStart(params_.remove_stride);
   const RemovalSamples& samples = removalSamples(start);
   // The samples that may be off the field: in each sector of bearings, a prefix of its list.
-  model_.sectorSafeRanges(pose, sector_safe_range_);
   candidates_.clear();
   for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
     const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
@@ -611,6 +644,126 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
   ++revision_;
   return stats;
+}
+
+namespace {
+
+// Ball blobs, measured over what a ball at their distance would show (BallGeometry).
+// The shape of a sighting of the ball: partly hidden balls (by a robot, the mirror's rim) count.
+bool ballSighting(const BallBlob& b) {
+  return b.pixels >= 4 && b.area_ratio >= 0.25 && b.area_ratio <= 1.8 && b.radial_ratio <= 1.6 &&
+         b.tangential_ratio <= 1.6 && b.fill >= 0.4;
+}
+// Evidence for a ball color not yet trained: a whole ball resting on the carpet.
+bool ballCandidate(const BallBlob& b) {
+  return b.ball_cells == 0 && b.pixels >= 12 && b.radial_ratio >= 0.6 && b.radial_ratio <= 1.6 &&
+         b.tangential_ratio >= 0.6 && b.tangential_ratio <= 1.6 && b.area_ratio >= 0.4 && b.area_ratio <= 1.6 &&
+         b.fill >= 0.55 && b.surround >= 0.6;
+}
+// Hypotheses not seen for this many cycles are dropped; a ball not seen for as long may be re-seeded.
+constexpr uint32_t kBallMemoryCycles = 15;
+// A blob's color matches a hypothesis within this many of its spreads, at least kBallMatchMin units.
+constexpr double kBallMatchSpreads = 2.5;
+constexpr double kBallMatchMin = 20.0;
+// Colors of a sighting added per cycle at most (every n-th of the blob's pixels).
+constexpr size_t kBallAddsPerCycle = 256;
+
+}  // namespace
+
+void ActTrainer::trainBall(const ImageView& image, CycleStats& stats) {
+  if (!clusters_[kGreen].trained()) return;
+  // The carpet as its cluster includes it (2.3's zeta sigma), where the table does not have it yet
+  // (a shadow): a ball's blob does not run into it. (The clusters of lines and goals can be wide
+  // enough to include a ball's colors.)
+  const double green_radius = params_.zeta * clusters_[kGreen].sigma();
+  ball_known_colors_.assign(1, {clusters_[kGreen].mean().cast<float>(), static_cast<float>(green_radius * green_radius)});
+  ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_);
+  const uint32_t now = static_cast<uint32_t>(revision_ + 1);
+  ClassCluster& ball = clusters_[kOrange];
+  const ClusterParams cluster_params = clusterParams();
+
+  // The ball: a blob of its shape whose color the ball's cluster includes (within zeta sigma); of
+  // several, the one with most pixels of the ball's class, then the largest. Without a cluster (a
+  // loaded table), the blob with most pixels of the class.
+  const BallBlob* seen = nullptr;
+  for (const BallBlob& b : ball_blobs_) {
+    if (!ballSighting(b)) continue;
+    if (ball.trained() ? (b.median - ball.mean()).norm() >= params_.zeta * ball.sigma() : b.ball_cells * 2 < b.pixels)
+      continue;
+    if (!seen || std::make_pair(b.ball_cells, b.pixels) > std::make_pair(seen->ball_cells, seen->pixels)) seen = &b;
+  }
+  auto train = [&](const BallBlob& b) {
+    std::vector<Eigen::Vector3f>& colors = samples_[kOrange];
+    colors.clear();
+    for (size_t j = 0; j < b.members.size(); ++j) {
+      if (b.interior[j] || b.members.size() < 20) {
+        uint8_t c[3];
+        image.color(static_cast<int>(b.members[j] % image.width), static_cast<int>(b.members[j] / image.width), c);
+        colors.emplace_back(c[0], c[1], c[2]);
+      }
+    }
+    if (ball.trained()) stats.doublings += ball.update(colors, cluster_params);
+    const size_t step = std::max<size_t>(1, b.members.size() / kBallAddsPerCycle);
+    add_weight_ = static_cast<int>(step);
+    for (size_t j = 0; j < b.members.size(); j += step) {
+      uint8_t c[3];
+      image.color(static_cast<int>(b.members[j] % image.width), static_cast<int>(b.members[j] / image.width), c);
+      stats.added[kOrange] += addColor(c, kOrange);
+    }
+  };
+  if (seen) {
+    // A table with ball colors but no cluster (a loaded one) seeds it from the sighting.
+    if (!ball.trained()) ball.set(seen->median, std::max(params_.sigma_min, seen->spread), true);
+    stats.ball.seen = true;
+    stats.ball.x_m = seen->base_x_m;
+    stats.ball.y_m = seen->base_y_m;
+    stats.ball.distance_m = seen->distance_m;
+    stats.ball.u = seen->centroid_u;
+    stats.ball.v = seen->centroid_v;
+    stats.ball.pixels = seen->ball_cells;
+    ball_last_seen_ = now;
+    train(*seen);
+  }
+
+  // Evidence for a ball color no class has (the blob's pixels are unknown to the table).
+  ball_hypotheses_.erase(std::remove_if(ball_hypotheses_.begin(), ball_hypotheses_.end(),
+                                        [&](const BallHypothesis& h) { return now - h.last_seen > kBallMemoryCycles; }),
+                         ball_hypotheses_.end());
+  const bool ball_lost = !ball.trained() || now - ball_last_seen_ > kBallMemoryCycles;
+  for (const BallBlob& b : ball_blobs_) {
+    if (&b == seen || !ballCandidate(b)) continue;
+    BallHypothesis* match = nullptr;
+    for (BallHypothesis& h : ball_hypotheses_) {
+      if ((b.median - h.mean).norm() < std::max(kBallMatchSpreads * h.spread, kBallMatchMin)) match = &h;
+    }
+    if (!match) {
+      ball_hypotheses_.push_back({b.median, b.spread, 0, now, {}});
+      match = &ball_hypotheses_.back();
+    } else if (match->last_seen == now) {
+      continue;  // one blob per color and frame
+    }
+    const double eta = params_.eta;
+    if (match->frames > 0) {
+      match->mean = (eta * match->mean + b.median) / (eta + 1.0);
+      match->spread = (eta * match->spread + b.spread) / (eta + 1.0);
+    }
+    ++match->frames;
+    match->last_seen = now;
+    const Eigen::Vector2d place(b.base_x_m, b.base_y_m);
+    bool new_place = match->places.size() < static_cast<size_t>(kBallSeedPlaces);
+    for (const Eigen::Vector2d& q : match->places) new_place = new_place && (q - place).norm() >= kBallPlaceSpacingM;
+    if (new_place) match->places.push_back(place);
+    const bool enough = match->frames >= kBallSeedFrames &&
+                        (static_cast<int>(match->places.size()) >= kBallSeedPlaces || match->frames >= 2 * kBallSeedFrames);
+    if (enough && ball_lost && !seen) {
+      ball.set(match->mean, std::max(params_.sigma_min, match->spread), true);
+      stats.ball_seeded = true;
+      ball_hypotheses_.clear();
+      prepareNearestMean();
+      train(b);
+      break;
+    }
+  }
 }
 
 template <class Pixels>
@@ -644,13 +797,16 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
     if (!model_.offField(sample.pixel, transform)) continue;
     ++stats.remove_candidates;
     // A clipped color is no evidence: a saturated line and a saturated window or lamp are the same
-    // color; the paper's rule alone decides about it.
-    const bool clipped = std::max({c[0], c[1], c[2]}) >= kClippedValue;
+    // color; the paper's rule alone decides about it. The ball is one small object whose colors are
+    // never expected from the pose: its clipped colors are evidence like any other, and one
+    // sighting off the field counts.
+    const bool ball = k == kOrange;
+    const bool clipped = !ball && std::max({c[0], c[1], c[2]}) >= kClippedValue;
     if (params_.evidence_removal_ratio > 0 && !clipped) {
       Evidence& e = evidence(cell);
       e.off_field += static_cast<float>(params_.remove_stride);
-      if (e.off_field >= kMinOffFieldSightings * params_.remove_stride &&
-          e.off_field > params_.evidence_removal_ratio * e.in_field) {
+      if (e.off_field >= (ball ? 1 : kMinOffFieldSightings) * params_.remove_stride &&
+          e.off_field > evidenceRatio(k) * e.in_field) {
         removeCell(cell);
         confirmed_[cell] = 0;
         ++stats.removed[k];

@@ -50,6 +50,16 @@ bool startsWithSuddenChange(const std::string& event) {
   return false;
 }
 
+// The trained classes and the ball.
+const std::vector<int>& reportedClasses() {
+  static const std::vector<int> classes = [] {
+    std::vector<int> k = core::trainableClasses();
+    k.push_back(core::kOrange);
+    return k;
+  }();
+  return classes;
+}
+
 double f1(double recall, double precision) {
   if (std::isnan(recall)) return std::nan("");
   if (std::isnan(precision) || recall + precision <= 0) return 0.0;
@@ -112,6 +122,8 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
   }
   core::TableCeiling ceiling;
   size_t segment_start = 0;
+  result.ball.assign(modes.size(), BallFigures{});
+  size_t ball_first_in_view = SIZE_MAX;
   const auto& frames = scene.scenario.frames;
   for (size_t i = 0; i < frames.size(); ++i) {
     const ScenarioFrame& f = frames[i];
@@ -124,12 +136,40 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
     const LabeledFrame frame = renderer.render(f.scene);
     const auto t1 = Clock::now();
     const core::ImageView view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
+    const uint64_t ball_truth = static_cast<uint64_t>(cv::countNonZero(frame.labels == core::kOrange));
+    if (ball_truth >= kMinBallTruthPixels && ball_first_in_view == SIZE_MAX) ball_first_in_view = i;
+    const bool count_ball = !f.scene.ball || (ball_first_in_view != SIZE_MAX && i >= ball_first_in_view + kBallFramesInView);
     for (size_t m = 0; m < modes.size(); ++m) {
       for (const std::string& e : f.events) evaluations[m].markEvent(e);
       if (i == 0) trainers[m].bootstrap(view, f.told_pose, std::max(0, options.bootstrap_cycles - 1));
-      trainers[m].cycle(view, f.told_pose);
+      const core::CycleStats stats = trainers[m].cycle(view, f.told_pose);
       segmenter.classify(trainers[m].lut(), view, labels[m]);
       evaluations[m].addFrame(labels[m], frame.labels);
+      BallFigures& b = result.ball[m];
+      b.ball_in_scene = f.scene.ball.has_value();
+      if (!count_ball) continue;
+      ++b.frames;
+      const cv::Mat predicted = (labels[m] == core::kOrange) & (frame.labels != core::kNotImaged);
+      const uint64_t n_predicted = static_cast<uint64_t>(cv::countNonZero(predicted));
+      if (!f.scene.ball) {
+        b.frames_with_ball_pixels += n_predicted > 0;
+        continue;
+      }
+      b.truth += ball_truth;
+      b.predicted += n_predicted;
+      b.hits += static_cast<uint64_t>(cv::countNonZero(predicted & (frame.labels == core::kOrange)));
+      if (ball_truth < kMinBallTruthPixels) continue;
+      ++b.frames_in_view;
+      if (!stats.ball.seen) continue;
+      ++b.sightings;
+      // The truth in base_link.
+      const core::Pose2D& pose = f.scene.robot_pose;
+      const double dx = f.scene.ball->x_m - pose.x_m, dy = f.scene.ball->y_m - pose.y_m;
+      const double c = std::cos(pose.theta_rad), s = std::sin(pose.theta_rad);
+      const double bx = c * dx + s * dy, by = -s * dx + c * dy;
+      const double error = std::hypot(stats.ball.x_m - bx, stats.ball.y_m - by);
+      b.position_errors_m.push_back(error);
+      b.position_ok += error <= 0.15 + 0.05 * std::hypot(bx, by);
     }
     const auto t2 = Clock::now();
     if (i - segment_start >= options.adapt_frames) ceiling.add(view, frame.labels);
@@ -173,7 +213,7 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
       const core::SegmentSummary& reference = s.segments[0][seg];
       const double frames_after =
           std::max(1.0, static_cast<double>(reference.frames) - static_cast<double>(s.adapt_frames));
-      for (int k : core::trainableClasses()) {
+      for (int k : reportedClasses()) {
         if (ceil.truthCount(k) < kMinTruthPixelsPerFrame * frames_after) continue;
         const double ceil_recall = ceil.recall(k), ceil_precision = ceil.precision(k);
         recall[modes][k].push_back(ceil_recall);
@@ -206,6 +246,36 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
         }
       }
     }
+  }
+  r.ball_recall.resize(modes);
+  r.ball_precision.resize(modes);
+  r.ball_position_ok.resize(modes);
+  r.ball_seen.resize(modes);
+  r.no_ball_false_frames.resize(modes);
+  r.no_ball_scenes_over_1pct.assign(modes, 0);
+  for (size_t m = 0; m < modes; ++m) {
+    std::vector<double> rec, prec, pos, seen, false_frames;
+    for (const SceneResult& s : results) {
+      if (m >= s.ball.size()) continue;
+      const BallFigures& b = s.ball[m];
+      if (!b.ball_in_scene) {
+        if (b.frames == 0) continue;
+        const double fraction = static_cast<double>(b.frames_with_ball_pixels) / b.frames;
+        false_frames.push_back(fraction);
+        r.no_ball_scenes_over_1pct[m] += fraction > 0.01;
+        continue;
+      }
+      if (b.truth < kMinBallTruthPixels * 5) continue;  // in view too briefly to be scored
+      rec.push_back(b.recall());
+      prec.push_back(b.predicted ? b.precision() : 0.0);
+      seen.push_back(b.frames_in_view ? static_cast<double>(b.sightings) / b.frames_in_view : 0.0);
+      pos.push_back(b.sightings ? static_cast<double>(b.position_ok) / b.sightings : 0.0);
+    }
+    r.ball_recall[m] = distribution(rec, true);
+    r.ball_precision[m] = distribution(prec, true);
+    r.ball_position_ok[m] = distribution(pos, true);
+    r.ball_seen[m] = distribution(seen, true);
+    r.no_ball_false_frames[m] = distribution(false_frames, false);
   }
   auto fill = [](const std::vector<Values>& v, bool higher_is_better) {
     std::vector<std::array<Distribution, core::kNumClasses>> out(v.size());
@@ -245,7 +315,7 @@ std::string formatReport(const FamilyReport& r) {
       out += line;
     }
     out += "\n";
-    for (int k : core::trainableClasses()) {
+    for (int k : reportedClasses()) {
       std::snprintf(line, sizeof(line), "  %-7s %5zu", core::className(k), d[0][k].count);
       out += line;
       for (size_t m = 0; m < n; ++m) out += " | " + dist(d[m][k]);
@@ -262,18 +332,32 @@ std::string formatReport(const FamilyReport& r) {
   for (size_t m = 0; m < modes; ++m) {
     std::snprintf(line, sizeof(line), "  %-26s", r.mode_names[m].c_str());
     out += line;
-    for (int k : core::trainableClasses()) {
+    for (int k : reportedClasses()) {
       std::snprintf(line, sizeof(line), " %s %zu (%+.2f)", core::className(k), r.f1_below_paper[m][k],
                     r.f1_worst_vs_paper[m][k]);
       out += line;
     }
     out += "\n";
   }
+  std::snprintf(line, sizeof(line),
+                "ball (issue 13; units: scenes; from %zu frames after the ball came into view; median p10 worst)\n",
+                kBallFramesInView);
+  out += line;
+  for (size_t m = 0; m < modes; ++m) {
+    std::snprintf(line, sizeof(line),
+                  "  %-26s scenes %zu: recall %s  precision %s  seen %s  position ok %s | no ball: scenes %zu, "
+                  "frames with ball pixels median %.3f worst %.3f, scenes over 1%% %zu\n",
+                  r.mode_names[m].c_str(), r.ball_recall[m].count, dist(r.ball_recall[m]).c_str(),
+                  dist(r.ball_precision[m]).c_str(), dist(r.ball_seen[m]).c_str(), dist(r.ball_position_ok[m]).c_str(),
+                  r.no_ball_false_frames[m].count, r.no_ball_false_frames[m].median, r.no_ball_false_frames[m].worst,
+                  r.no_ball_scenes_over_1pct[m]);
+    out += line;
+  }
   out += "worst recall / precision at seed\n";
   for (size_t m = 0; m < modes; ++m) {
     std::snprintf(line, sizeof(line), "  %-26s", r.mode_names[m].c_str());
     out += line;
-    for (int k : core::trainableClasses()) {
+    for (int k : reportedClasses()) {
       std::snprintf(line, sizeof(line), " %s %u/%u", core::className(k), r.worst_recall_seed[m][k],
                     r.worst_precision_seed[m][k]);
       out += line;
@@ -292,7 +376,7 @@ std::string formatScene(const SceneResult& s) {
   for (size_t seg = 0; seg < s.ceiling.size(); ++seg) {
     std::snprintf(line, sizeof(line), "  segment '%s' F1", s.segments[0][seg].event.c_str());
     out += line;
-    for (int k : core::trainableClasses()) {
+    for (int k : reportedClasses()) {
       if (s.ceiling[seg].truthCount(k) == 0) continue;
       std::snprintf(line, sizeof(line), "  %s", core::className(k));
       out += line;
@@ -305,6 +389,19 @@ std::string formatScene(const SceneResult& s) {
       out += line;
     }
     out += "\n";
+  }
+  for (size_t m = 0; m < s.ball.size(); ++m) {
+    const BallFigures& b = s.ball[m];
+    if (b.ball_in_scene) {
+      std::snprintf(line, sizeof(line),
+                    "  ball %-10s frames %zu (in view %zu): recall %.2f precision %.2f, seen %zu, position ok %zu\n",
+                    s.mode_names[m].c_str(), b.frames, b.frames_in_view, b.recall(), b.precision(), b.sightings,
+                    b.position_ok);
+    } else {
+      std::snprintf(line, sizeof(line), "  no ball %-10s frames %zu, with ball pixels %zu\n", s.mode_names[m].c_str(),
+                    b.frames, b.frames_with_ball_pixels);
+    }
+    out += line;
   }
   return out;
 }

@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "act_color/core/ball_detector.hpp"
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/class_cluster.hpp"
 #include "act_color/core/color_lut.hpp"
@@ -70,6 +71,15 @@ struct ActParams {
   // color (on a real image brightened 1.5x the rule took white's saturated cell and lost 80% of the
   // line pixels). 0: off.
   double evidence_removal_ratio = 3.0;
+  // Beyond the paper, which leaves the ball out (2.1): the ball's color is learned from its shape.
+  // Compact blobs on the carpet of the image size a sphere of ball_diameter_m has at their
+  // distance, surrounded by carpet and of a color no trained class has, are ball candidates; a
+  // color that is such a candidate in kBallSeedFrames frames (at several places, or twice as many
+  // frames at one) seeds the ball's cluster (class 6). From then on the blob classified as the ball
+  // updates the cluster (eq. 4, 5) and adds its colors (2.3); the ball never takes a color of
+  // another class, and 2.4 removes its colors seen off the field like the others'.
+  bool ball_training = true;
+  double ball_diameter_m = 0.22;
 
   void validate() const;
   // Sets the parameter `name` (as the field is named) from text; throws std::invalid_argument for
@@ -94,7 +104,23 @@ struct CycleStats {
   bool color_space_changed = false;                     // table reset for a new color space
   bool light_change = false;                            // light compensation applied
   Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain at the carpet's color
+  bool ball_seeded = false;                             // the ball's cluster was (re)seeded
+  // The ball as seen in this image (ActParams::ball_training), under the table before 2.4.
+  struct Ball {
+    bool seen = false;
+    double x_m = 0, y_m = 0;  // its centre on the carpet, base_link
+    double distance_m = 0;
+    double u = 0, v = 0;  // image centroid of its blob
+    uint32_t pixels = 0;
+  } ball;
 };
+
+// Ball training (ActParams::ball_training): frames of consistent evidence before a color seeds
+// the ball's cluster, and the distinct places (ball positions in base_link kBallPlaceSpacingM
+// apart) among them; at a single place twice the frames are needed.
+constexpr int kBallSeedFrames = 10;
+constexpr int kBallSeedPlaces = 3;
+constexpr double kBallPlaceSpacingM = 0.3;
 
 // The ACT algorithm (paper, section 2): one cycle per image and pose.
 class ActTrainer {
@@ -138,8 +164,12 @@ class ActTrainer {
   // The class a sample expected as k trains (robots_train_black re-routes green and goal colors
   // of robots to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
+  // ActParams::evidence_removal_ratio for class k (lower for the ball).
+  double evidenceRatio(uint8_t k) const;
   // Light compensation: the map moves every cluster and every table cell.
   void applyLightChange(const LightModel::Map& map);
+  // The ball stage (ActParams::ball_training), after 2.3; needs sector_safe_range_ of the pose.
+  void trainBall(const ImageView& image, CycleStats& stats);
 
   struct Evidence {
     float in_field = 0.f;
@@ -212,6 +242,19 @@ class ActTrainer {
   template <class Pixels>
   void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
   int removal_samples_stride_ = 0;
+  // Ball training.
+  BallDetector ball_detector_;
+  std::vector<BallBlob> ball_blobs_;
+  std::vector<BallDetector::KnownColor> ball_known_colors_;
+  struct BallHypothesis {
+    Eigen::Vector3d mean;
+    double spread = 0;
+    int frames = 0;
+    uint32_t last_seen = 0;
+    std::vector<Eigen::Vector2d> places;  // base_link
+  };
+  std::vector<BallHypothesis> ball_hypotheses_;
+  uint32_t ball_last_seen_ = 0;  // cycle of the last sighting
 };
 
 }  // namespace core

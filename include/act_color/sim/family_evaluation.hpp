@@ -29,6 +29,25 @@ struct EvalOptions {
   std::string png_dir;         // when set: input | modes | truth of each segment's last frame
 };
 
+// Issue 13's figures of the ball in one scene and mode. In scenes with a ball: pixels pooled over
+// the frames from kBallFramesInView frames after the ball first came into view (at least
+// kMinBallTruthPixels of it imaged); the ball's reported position (CycleStats::ball) against the
+// truth in those frames. In scenes without one: the frames with any pixel classified as the ball.
+constexpr size_t kBallFramesInView = 30;
+constexpr uint64_t kMinBallTruthPixels = 10;
+struct BallFigures {
+  bool ball_in_scene = false;
+  size_t frames = 0;  // counted frames (with a ball: after kBallFramesInView in view)
+  uint64_t truth = 0, predicted = 0, hits = 0;  // ball pixels in the truth, classified, both
+  size_t frames_in_view = 0;                    // of the counted frames, with the ball in view
+  size_t sightings = 0;                         // of those, with a position reported
+  size_t position_ok = 0;                       // of the sightings, within 0.15 m + 5% of the distance
+  std::vector<double> position_errors_m;
+  size_t frames_with_ball_pixels = 0;  // without a ball: frames with any pixel classified as the ball
+  double recall() const { return truth ? static_cast<double>(hits) / truth : std::nan(""); }
+  double precision() const { return predicted ? static_cast<double>(hits) / predicted : std::nan(""); }
+};
+
 // One scene run with every mode on the same rendered frames, and the fixed-table ceiling of each
 // segment (TableCeiling over the segment's frames after adaptation).
 struct SceneResult {
@@ -41,6 +60,7 @@ struct SceneResult {
   size_t adapt_frames = 12;
   double render_seconds = 0.0;
   double act_seconds = 0.0;  // training and classification, all modes
+  std::vector<BallFigures> ball;  // [mode]
 };
 
 SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>& modes, const EvalOptions& options);
@@ -68,6 +88,11 @@ struct FamilyReport {
   std::vector<std::array<double, core::kNumClasses>> f1_worst_vs_paper;
   // Seeds of the units behind each worst case [mode][class], for looking at them.
   std::vector<std::array<uint32_t, core::kNumClasses>> worst_recall_seed, worst_precision_seed;
+  // [mode]: the ball (BallFigures) over scenes with a ball in view long enough: recall, precision
+  // and the fraction of sightings within the position tolerance; the fraction of frames seen;
+  // over scenes without a ball, the fraction of frames with ball pixels.
+  std::vector<Distribution> ball_recall, ball_precision, ball_position_ok, ball_seen, no_ball_false_frames;
+  std::vector<size_t> no_ball_scenes_over_1pct;
 };
 
 FamilyReport summarize(const std::vector<SceneResult>& results);

@@ -1,0 +1,114 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "act_color/core/color_lut.hpp"
+#include "act_color/core/expected_class_model.hpp"
+#include "act_color/core/image_view.hpp"
+
+namespace act_color {
+namespace core {
+
+// The image of a ball (a sphere of known radius resting on the floor) through the contract's
+// camera model. A sphere seen from the viewpoint fills a circular cone of directions around the
+// direction to its centre: its image reaches from the elevation e_c - a to e_c + a radially and
+// about +-b in bearing, with a = asin(radius / distance to the centre).
+class BallGeometry {
+ public:
+  // Keeps a reference to the camera: a short-lived helper.
+  BallGeometry(const OmniCameraModel& camera, double radius_m);
+
+  struct Image {
+    double radial_px = 0;      // extent along the image radius
+    double tangential_px = 0;  // extent across it, at the centre's radius
+    double area_px = 0;        // of the ellipse with these axes
+  };
+  // Expected image of a ball whose centre stands at ground distance d from the robot; false when
+  // its centre is not imaged.
+  bool expected(double ground_distance_m, Image* out) const;
+  // Ground distance of the ball's centre from the image radii of its near and far edge (the
+  // midpoint of their elevations is the centre's direction); NaN when it is not on the floor.
+  double distanceFromRadii(double r_near_px, double r_far_px) const;
+  double radius() const { return radius_m_; }
+
+ private:
+  const OmniCameraModel& camera_;
+  double radius_m_;
+};
+
+// A connected blob of pixels on the carpet whose table class is unknown or the ball's, measured
+// as a ball would be.
+struct BallBlob {
+  uint32_t pixels = 0;      // in the blob
+  uint32_t ball_cells = 0;  // of them classified as the ball
+  double centroid_u = 0, centroid_v = 0;
+  double r_near_px = 0, r_far_px = 0;  // image radii of the nearest and farthest pixel
+  double distance_m = 0;               // ground distance of the ball's centre (BallGeometry)
+  double base_x_m = 0, base_y_m = 0;   // the ball's centre on the carpet, base_link
+  // Measured over expected (BallGeometry::expected at distance_m).
+  double radial_ratio = 0, tangential_ratio = 0, area_ratio = 0;
+  double fill = 0;      // pixels over the ellipse of the measured extents
+  double surround = 0;  // of the pixels around the blob, the fraction classified green or white
+  Eigen::Vector3d median{0, 0, 0};  // per-channel median color
+  double spread = 0;                // RMS distance of the colors to their mean (as eq. 5's sigma)
+  std::vector<uint32_t> members;    // pixel indices (row-major), for training
+  std::vector<uint8_t> interior;    // 1 where all four neighbours are in the blob too
+};
+
+// Finds ball-like blobs on the carpet: a coarse grid of floor pixels (spaced so that the smallest
+// ball image on the field covers several of them) is classified with the table; connected runs of
+// unknown or ball pixels that are surely on the carpet at this pose are grown at full resolution
+// and measured. About 1/stride^2 of the floor pixels are looked up per cycle.
+class BallDetector {
+ public:
+  // Prepared for the model's camera and field (the model is not kept: pass the same to detect).
+  BallDetector(const ExpectedClassModel& model, double radius_m);
+
+  // A color a trained class's cluster includes: pixels unknown to the table but of such a color
+  // (the carpet in a shadow not yet trained) are not the ball's.
+  struct KnownColor {
+    Eigen::Vector3f mean;
+    float radius_sq;
+  };
+  // Blobs of this image at this pose; `sector_safe_range` from ExpectedClassModel::sectorSafeRanges.
+  // Blobs far larger than any ball image are skipped.
+  void detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
+              const std::array<double, ExpectedClassModel::kRemovalSectors>& sector_safe_range,
+              const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs);
+
+  double radius() const { return radius_m_; }
+  int stride() const { return stride_; }
+
+ private:
+  using SafeRanges = std::array<double, ExpectedClassModel::kRemovalSectors>;
+  void measure(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut, const SafeRanges& safe,
+               const std::vector<uint32_t>& seeds, BallBlob* blob);
+  // The pixel's class for the blobs: the table's, or for unknown colors that a known class's
+  // cluster includes, that class.
+  uint8_t classOf(const ColorLut& lut, const uint8_t c[3]) const;
+  const std::vector<KnownColor>* known_ = nullptr;
+
+  double radius_m_;
+  int stride_ = 3;
+  int grid_w_ = 0, grid_h_ = 0;
+  double max_area_px_ = 0;  // the largest ball image on the carpet
+  struct GridPoint {
+    uint32_t cell;   // index in the grid
+    uint32_t pixel;  // index in the image
+    float range_m;
+    uint8_t sector;
+  };
+  std::vector<GridPoint> points_;  // the grid's floor pixels
+  // Per-cycle scratch.
+  std::vector<uint8_t> grid_;
+  std::vector<uint32_t> stack_;
+  std::vector<uint32_t> component_;
+  std::vector<int32_t> window_;  // full-resolution marks of the blob being grown
+  std::vector<uint32_t> pixel_stack_;
+};
+
+}  // namespace core
+}  // namespace act_color

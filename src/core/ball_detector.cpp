@@ -1,0 +1,346 @@
+#include "act_color/core/ball_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace act_color {
+namespace core {
+namespace {
+
+// The grid is spaced so that the smallest ball image on the carpet spans this many grid points
+// across its narrower extent.
+constexpr double kGridPointsAcrossBall = 2.0;
+constexpr int kMinGridStride = 2;  // a ball of fewer pixels is still found when one grid point hits it
+constexpr int kMaxGridStride = 4;
+// Ground distances over which the grid spacing and the largest ball image are computed.
+constexpr double kNearestDistanceM = 0.3;
+constexpr double kDistanceStepM = 0.05;
+// Components of more grid points than this many times the largest ball image are not a ball.
+constexpr double kMaxAreaFactor = 2.5;
+// Blobs looked at per cycle at most (the largest first).
+constexpr size_t kMaxBlobs = 8;
+
+constexpr uint8_t kGridOff = 0;      // not on the carpet, or not a grid point
+constexpr uint8_t kGridBall = 1;     // unknown or the ball's class
+constexpr uint8_t kGridCarpet = 2;   // green or white
+constexpr uint8_t kGridOther = 3;    // another class
+constexpr uint8_t kGridVisited = 4;  // a ball grid point already in a component
+
+bool ballCandidate(uint8_t k) { return k == kUnknown || k == kOrange; }
+
+}  // namespace
+
+BallGeometry::BallGeometry(const OmniCameraModel& camera, double radius_m) : camera_(camera), radius_m_(radius_m) {}
+
+bool BallGeometry::expected(double d, Image* out) const {
+  const double h = camera_.viewpointHeight() - radius_m_;  // viewpoint above the ball's centre
+  const double rho = std::hypot(d, h);
+  if (!(rho > radius_m_)) return false;
+  const double e_c = -std::atan2(h, d);
+  const double a = std::asin(radius_m_ / rho);
+  const double r_c = camera_.radiusAtElevation(e_c);
+  if (!std::isfinite(r_c)) return false;
+  // Edges beyond the table's ends are cut at them (the chassis, the mirror's rim).
+  const auto& map = camera_.calibration().elevation_map;
+  const double r_lo = camera_.radiusAtElevation(std::max(e_c - a, map.front().second));
+  const double r_hi = camera_.radiusAtElevation(std::min(e_c + a, map.back().second));
+  // Half the bearing range of the cone at the centre's elevation: cos a = cos^2 e cos b + sin^2 e.
+  const double s2 = std::sin(e_c) * std::sin(e_c), c2 = 1.0 - s2;
+  const double b = std::acos(std::clamp((std::cos(a) - s2) / c2, -1.0, 1.0));
+  out->radial_px = r_hi - r_lo;
+  out->tangential_px = 2.0 * b * r_c;
+  out->area_px = M_PI / 4.0 * out->radial_px * out->tangential_px;
+  return true;
+}
+
+double BallGeometry::distanceFromRadii(double r_near_px, double r_far_px) const {
+  const auto& map = camera_.calibration().elevation_map;
+  const double e_near = camera_.elevationAtRadius(std::clamp(r_near_px, map.front().first, map.back().first));
+  const double e_far = camera_.elevationAtRadius(std::clamp(r_far_px, map.front().first, map.back().first));
+  const double e_c = 0.5 * (e_near + e_far);
+  const double h = camera_.viewpointHeight() - radius_m_;
+  if (!(e_c < 0) || !(h > 0)) return std::numeric_limits<double>::quiet_NaN();
+  return h / std::tan(-e_c);
+}
+
+namespace {
+
+bool onCarpet(const ExpectedClassModel& model, size_t pixel,
+              const std::array<double, ExpectedClassModel::kRemovalSectors>& safe) {
+  if (model.camera().ray(pixel).region != PixelRegion::kFloor) return false;
+  return !ExpectedClassModel::mayBeOffField(model.removalRange(pixel),
+                                            safe[static_cast<size_t>(model.removalSector(pixel))]);
+}
+
+}  // namespace
+
+BallDetector::BallDetector(const ExpectedClassModel& model, double radius_m) : radius_m_(radius_m) {
+  const OmniCameraModel& camera = model.camera();
+  const BallGeometry geometry(camera, radius_m);
+  const FieldModel& field = model.field();
+  const double farthest =
+      std::hypot(2.0 * field.halfLength(), 2.0 * (field.halfWidth() + field.calibration().margin_m));
+  double smallest = std::numeric_limits<double>::infinity();
+  for (double d = kNearestDistanceM; d <= farthest; d += kDistanceStepM) {
+    BallGeometry::Image im;
+    if (!geometry.expected(d, &im)) continue;
+    max_area_px_ = std::max(max_area_px_, im.area_px);
+    smallest = std::min(smallest, std::min(im.radial_px, im.tangential_px));
+  }
+  if (std::isfinite(smallest)) {
+    stride_ = std::clamp(static_cast<int>(smallest / kGridPointsAcrossBall), kMinGridStride, kMaxGridStride);
+  }
+  grid_w_ = (camera.width() + stride_ - 1) / stride_;
+  grid_h_ = (camera.height() + stride_ - 1) / stride_;
+  for (int gy = 0; gy < grid_h_; ++gy) {
+    for (int gx = 0; gx < grid_w_; ++gx) {
+      const int u = std::min(gx * stride_ + stride_ / 2, camera.width() - 1);
+      const int v = std::min(gy * stride_ + stride_ / 2, camera.height() - 1);
+      const size_t pixel = static_cast<size_t>(v) * camera.width() + u;
+      if (camera.ray(pixel).region != PixelRegion::kFloor) continue;
+      points_.push_back({static_cast<uint32_t>(gy * grid_w_ + gx), static_cast<uint32_t>(pixel),
+                         model.removalRange(pixel), static_cast<uint8_t>(model.removalSector(pixel))});
+    }
+  }
+  grid_.assign(static_cast<size_t>(grid_w_) * grid_h_, kGridOff);
+  window_.assign(model.pixels(), -1);
+}
+
+uint8_t BallDetector::classOf(const ColorLut& lut, const uint8_t c[3]) const {
+  const uint8_t k = lut.classOf(c[0], c[1], c[2]);
+  if (k != kUnknown) return k;
+  const Eigen::Vector3f color(c[0], c[1], c[2]);
+  for (const KnownColor& known : *known_) {
+    if ((known.mean - color).squaredNorm() < known.radius_sq) return kGreen;  // not the ball's
+  }
+  return kUnknown;
+}
+
+void BallDetector::detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
+                          const SafeRanges& safe, const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs) {
+  blobs->clear();
+  known_ = &known;
+  const int width = image.width;
+  // The grid's classes.
+  for (const GridPoint& p : points_) {
+    uint8_t g = kGridOff;
+    if (!ExpectedClassModel::mayBeOffField(p.range_m, safe[p.sector])) {
+      uint8_t c[3];
+      image.color(static_cast<int>(p.pixel % width), static_cast<int>(p.pixel / width), c);
+      const uint8_t k = classOf(lut, c);
+      g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
+    }
+    grid_[p.cell] = g;
+  }
+  // Connected components of ball grid points (8-neighbourhood), the largest first.
+  struct Component {
+    size_t begin, end;
+  };
+  std::vector<Component> components;
+  component_.clear();
+  const size_t max_points = static_cast<size_t>(kMaxAreaFactor * max_area_px_ / (stride_ * stride_)) + 4;
+  for (const GridPoint& p : points_) {
+    if (grid_[p.cell] != kGridBall) continue;
+    const size_t begin = component_.size();
+    stack_.assign(1, p.cell);
+    grid_[p.cell] = kGridVisited;
+    while (!stack_.empty()) {
+      const uint32_t cell = stack_.back();
+      stack_.pop_back();
+      component_.push_back(cell);
+      const int gx = static_cast<int>(cell % grid_w_), gy = static_cast<int>(cell / grid_w_);
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = gx + dx, y = gy + dy;
+          if (x < 0 || y < 0 || x >= grid_w_ || y >= grid_h_) continue;
+          const uint32_t n = static_cast<uint32_t>(y * grid_w_ + x);
+          if (grid_[n] != kGridBall) continue;
+          grid_[n] = kGridVisited;
+          stack_.push_back(n);
+        }
+      }
+    }
+    if (component_.size() - begin > max_points) {
+      component_.resize(begin);  // far larger than a ball: an untrained region
+      continue;
+    }
+    components.push_back({begin, component_.size()});
+  }
+  for (const GridPoint& p : points_) grid_[p.cell] = kGridOff;
+  std::sort(components.begin(), components.end(),
+            [](const Component& a, const Component& b) { return a.end - a.begin > b.end - b.begin; });
+  if (components.size() > kMaxBlobs) components.resize(kMaxBlobs);
+  std::vector<uint32_t> seeds;
+  for (const Component& c : components) {
+    seeds.clear();
+    for (size_t j = c.begin; j < c.end; ++j) {
+      const uint32_t cell = component_[j];
+      const int u = std::min(static_cast<int>(cell % grid_w_) * stride_ + stride_ / 2, width - 1);
+      const int v = std::min(static_cast<int>(cell / grid_w_) * stride_ + stride_ / 2, image.height - 1);
+      seeds.push_back(static_cast<uint32_t>(v * width + u));
+    }
+    BallBlob blob;
+    measure(model, image, lut, safe, seeds, &blob);
+    if (blob.pixels > 0) blobs->push_back(std::move(blob));
+  }
+}
+
+void BallDetector::measure(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
+                           const SafeRanges& safe, const std::vector<uint32_t>& seeds, BallBlob* blob) {
+  const int width = image.width, height = image.height;
+  const CameraCalibration& cal = model.camera().calibration();
+  const BallGeometry geometry(model.camera(), radius_m_);
+  // The blob grows at full resolution from the grid points, within their box plus one spacing.
+  int u0 = width, u1 = -1, v0 = height, v1 = -1;
+  for (const uint32_t s : seeds) {
+    const int u = static_cast<int>(s % width), v = static_cast<int>(s / width);
+    u0 = std::min(u0, u);
+    u1 = std::max(u1, u);
+    v0 = std::min(v0, v);
+    v1 = std::max(v1, v);
+  }
+  u0 = std::max(0, u0 - stride_);
+  v0 = std::max(0, v0 - stride_);
+  u1 = std::min(width - 1, u1 + stride_);
+  v1 = std::min(height - 1, v1 + stride_);
+  // window_: -1 not looked at, 0 looked at and not in the blob, 1 in the blob.
+  auto look = [&](uint32_t pixel) {
+    int32_t& mark = window_[pixel];
+    if (mark >= 0) return false;
+    mark = 0;
+    if (!onCarpet(model, pixel, safe)) return false;
+    uint8_t c[3];
+    image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
+    const uint8_t k = classOf(lut, c);
+    if (!ballCandidate(k)) return false;
+    mark = 1;
+    if (k == kOrange) ++blob->ball_cells;
+    return true;
+  };
+  std::vector<uint32_t> looked;
+  pixel_stack_.clear();
+  for (const uint32_t s : seeds) {
+    if (look(s)) pixel_stack_.push_back(s);
+    looked.push_back(s);
+  }
+  while (!pixel_stack_.empty()) {
+    const uint32_t p = pixel_stack_.back();
+    pixel_stack_.pop_back();
+    blob->members.push_back(p);
+    const int u = static_cast<int>(p % width), v = static_cast<int>(p / width);
+    const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+    for (int n = 0; n < 4; ++n) {
+      const int x = u + du[n], y = v + dv[n];
+      if (x < u0 || x > u1 || y < v0 || y > v1) continue;
+      const uint32_t q = static_cast<uint32_t>(y * width + x);
+      if (window_[q] >= 0) continue;
+      looked.push_back(q);
+      if (look(q)) pixel_stack_.push_back(q);
+    }
+  }
+  blob->pixels = static_cast<uint32_t>(blob->members.size());
+  if (blob->pixels == 0) {
+    for (const uint32_t q : looked) window_[q] = -1;
+    return;
+  }
+  // Shape in polar coordinates about the mirror's axis.
+  double su = 0, sv = 0;
+  for (const uint32_t p : blob->members) {
+    su += p % width;
+    sv += p / width;
+  }
+  blob->centroid_u = su / blob->pixels;
+  blob->centroid_v = sv / blob->pixels;
+  const double phi_c = std::atan2(blob->centroid_v - cal.center_v, blob->centroid_u - cal.center_u);
+  double r_min = std::numeric_limits<double>::infinity(), r_max = 0, a_min = 0, a_max = 0, r_sum = 0;
+  for (const uint32_t p : blob->members) {
+    const double du = static_cast<double>(p % width) - cal.center_u, dv = static_cast<double>(p / width) - cal.center_v;
+    const double r = std::hypot(du, dv);
+    double a = std::atan2(dv, du) - phi_c;
+    if (a > M_PI) a -= 2 * M_PI;
+    if (a < -M_PI) a += 2 * M_PI;
+    r_min = std::min(r_min, r);
+    r_max = std::max(r_max, r);
+    a_min = std::min(a_min, a);
+    a_max = std::max(a_max, a);
+    r_sum += r;
+  }
+  blob->r_near_px = r_min - 0.5;
+  blob->r_far_px = r_max + 0.5;
+  const double r_c = r_sum / blob->pixels;
+  const double radial = blob->r_far_px - blob->r_near_px;
+  const double tangential = (a_max - a_min) * r_c + 1.0;
+  blob->fill = blob->pixels / (M_PI / 4.0 * radial * tangential);
+  blob->distance_m = geometry.distanceFromRadii(blob->r_near_px, blob->r_far_px);
+  const double bearing = cal.bearing_sign * phi_c + cal.bearing_offset_rad;
+  BallGeometry::Image expected;
+  if (std::isfinite(blob->distance_m) && geometry.expected(blob->distance_m, &expected)) {
+    blob->base_x_m = blob->distance_m * std::cos(bearing);
+    blob->base_y_m = blob->distance_m * std::sin(bearing);
+    blob->radial_ratio = radial / expected.radial_px;
+    blob->tangential_ratio = tangential / expected.tangential_px;
+    blob->area_ratio = blob->pixels / expected.area_px;
+  }
+  // Interior pixels, and the colors.
+  blob->interior.assign(blob->members.size(), 0);
+  std::array<std::vector<uint8_t>, 3> channels;
+  Eigen::Vector3d sum(0, 0, 0);
+  std::vector<Eigen::Vector3d> colors;
+  for (size_t j = 0; j < blob->members.size(); ++j) {
+    const uint32_t p = blob->members[j];
+    const int u = static_cast<int>(p % width), v = static_cast<int>(p / width);
+    const bool inner = u > 0 && v > 0 && u + 1 < width && v + 1 < height && window_[p + 1] == 1 &&
+                       window_[p - 1] == 1 && window_[p + width] == 1 && window_[p - width] == 1;
+    blob->interior[j] = inner ? 1 : 0;
+  }
+  const size_t inner_count = static_cast<size_t>(std::count(blob->interior.begin(), blob->interior.end(), 1));
+  const bool use_inner = inner_count >= 5;
+  for (size_t j = 0; j < blob->members.size(); ++j) {
+    if (use_inner && !blob->interior[j]) continue;
+    const uint32_t p = blob->members[j];
+    uint8_t c[3];
+    image.color(static_cast<int>(p % width), static_cast<int>(p / width), c);
+    for (int ch = 0; ch < 3; ++ch) channels[ch].push_back(c[ch]);
+    colors.emplace_back(c[0], c[1], c[2]);
+    sum += colors.back();
+  }
+  for (int ch = 0; ch < 3; ++ch) {
+    auto& values = channels[ch];
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    blob->median[ch] = values[values.size() / 2];
+  }
+  const Eigen::Vector3d mean = sum / static_cast<double>(colors.size());
+  double sq = 0;
+  for (const auto& c : colors) sq += (c - mean).squaredNorm();
+  blob->spread = colors.size() > 1 ? std::sqrt(sq / (colors.size() - 1.0)) : 0.0;
+  // What lies around the blob: a ball rests on the carpet.
+  const int grow = std::max(2, static_cast<int>(std::lround(0.25 * std::max(radial, tangential))));
+  int bu0 = width, bu1 = -1, bv0 = height, bv1 = -1;
+  for (const uint32_t p : blob->members) {
+    const int u = static_cast<int>(p % width), v = static_cast<int>(p / width);
+    bu0 = std::min(bu0, u);
+    bu1 = std::max(bu1, u);
+    bv0 = std::min(bv0, v);
+    bv1 = std::max(bv1, v);
+  }
+  uint32_t around = 0, carpet = 0;
+  for (int v = std::max(0, bv0 - grow); v <= std::min(height - 1, bv1 + grow); ++v) {
+    for (int u = std::max(0, bu0 - grow); u <= std::min(width - 1, bu1 + grow); ++u) {
+      const size_t p = static_cast<size_t>(v) * width + u;
+      if (window_[p] == 1) continue;
+      const PixelRegion region = model.camera().ray(p).region;
+      if (region == PixelRegion::kNotImaged || region == PixelRegion::kSelf) continue;
+      ++around;
+      uint8_t c[3];
+      image.color(u, v, c);
+      const uint8_t k = lut.classOf(c[0], c[1], c[2]);
+      carpet += k == kGreen || k == kWhite;
+    }
+  }
+  blob->surround = around ? static_cast<double>(carpet) / around : 0.0;
+  for (const uint32_t q : looked) window_[q] = -1;
+}
+
+}  // namespace core
+}  // namespace act_color
