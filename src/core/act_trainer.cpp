@@ -620,7 +620,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   });
 
   model_.sectorSafeRanges(pose, sector_safe_range_);
-  if (params_.ball_training) trainBall(image, stats);
+  if (params_.ball_training) trainBall(image, transform, stats);
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
   const size_t start = randomStart(params_.remove_stride);
@@ -670,17 +670,37 @@ constexpr size_t kBallAddsPerCycle = 256;
 
 }  // namespace
 
-void ActTrainer::trainBall(const ImageView& image, CycleStats& stats) {
+void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transform, CycleStats& stats) {
   if (!clusters_[kGreen].trained()) return;
-  // The carpet as its cluster includes it (2.3's zeta sigma), where the table does not have it yet
-  // (a shadow): a ball's blob does not run into it. (The clusters of lines and goals can be wide
-  // enough to include a ball's colors.)
+  // The carpet as its cluster includes it (2.3's zeta sigma, the intensity weighed as in the
+  // nearest-mean rule), where the table does not have it yet (a shadow): a ball's blob does not run
+  // into it. (The clusters of lines and goals can be wide enough to include a ball's colors.)
   const double green_radius = params_.zeta * clusters_[kGreen].sigma();
-  ball_known_colors_.assign(1, {clusters_[kGreen].mean().cast<float>(), static_cast<float>(green_radius * green_radius)});
-  ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_);
+  ball_known_colors_.assign(1, {clusters_[kGreen].mean().cast<float>(), static_cast<float>(green_radius * green_radius),
+                                static_cast<float>(kIntensityWeight), lut_.colorSpace() == ColorSpace::kYuv});
+  ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_, &ball_off_field_);
   const uint32_t now = static_cast<uint32_t>(revision_ + 1);
   ClassCluster& ball = clusters_[kOrange];
   const ClusterParams cluster_params = clusterParams();
+
+  // 2.4's evidence for the ball's colors, from the detector's denser look off the field.
+  if (params_.evidence_removal_ratio > 0) {
+    const float weight = static_cast<float>(ball_detector_.stride() * ball_detector_.stride());
+    for (const uint32_t pixel : ball_off_field_) {
+      if (!model_.offField(pixel, transform)) continue;
+      uint8_t c[3];
+      image.color(static_cast<int>(pixel % image.width), static_cast<int>(pixel / image.width), c);
+      const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+      if (lut_.at(cell) != kOrange) continue;  // removed by an earlier pixel of this cycle
+      Evidence& e = evidence(cell);
+      e.off_field += weight;
+      if (e.off_field > evidenceRatio(kOrange) * e.in_field) {
+        removeCell(cell);
+        confirmed_[cell] = 0;
+        ++stats.removed[kOrange];
+      }
+    }
+  }
 
   // The ball: a blob of its shape whose color the ball's cluster includes (within zeta sigma); of
   // several, the one with most pixels of the ball's class, then the largest. Without a cluster (a

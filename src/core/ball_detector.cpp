@@ -18,6 +18,10 @@ constexpr double kNearestDistanceM = 0.3;
 constexpr double kDistanceStepM = 0.05;
 // Components of more grid points than this many times the largest ball image are not a ball.
 constexpr double kMaxAreaFactor = 2.5;
+// A blob grows through colors within this many of its grid points' spreads of their mean, and at
+// least kGrowMinRadius units (a sphere's shading spans a range of intensities).
+constexpr double kGrowSpreads = 3.0;
+constexpr double kGrowMinRadius = 45.0;
 // Blobs looked at per cycle at most (the largest first).
 constexpr size_t kMaxBlobs = 8;
 
@@ -66,11 +70,13 @@ double BallGeometry::distanceFromRadii(double r_near_px, double r_far_px) const 
 
 namespace {
 
+// A ball on the carpet: its pixels' view rays pass over the carpet at the ball's top, 2 radii up.
+// Their floor points lie up to height / (height - 2 radii) times as far (a ball near a line at
+// the field's edge reaches far beyond it in the image).
 bool onCarpet(const ExpectedClassModel& model, size_t pixel,
-              const std::array<double, ExpectedClassModel::kRemovalSectors>& safe) {
+              const std::array<double, ExpectedClassModel::kRemovalSectors>& safe, double reach) {
   if (model.camera().ray(pixel).region != PixelRegion::kFloor) return false;
-  return !ExpectedClassModel::mayBeOffField(model.removalRange(pixel),
-                                            safe[static_cast<size_t>(model.removalSector(pixel))]);
+  return model.removalRange(pixel) < reach * safe[static_cast<size_t>(model.removalSector(pixel))];
 }
 
 }  // namespace
@@ -91,6 +97,8 @@ BallDetector::BallDetector(const ExpectedClassModel& model, double radius_m) : r
   if (std::isfinite(smallest)) {
     stride_ = std::clamp(static_cast<int>(smallest / kGridPointsAcrossBall), kMinGridStride, kMaxGridStride);
   }
+  const double h = camera.viewpointHeight();
+  reach_ = h > 2.0 * radius_m ? h / (h - 2.0 * radius_m) : std::numeric_limits<double>::infinity();
   grid_w_ = (camera.width() + stride_ - 1) / stride_;
   grid_h_ = (camera.height() + stride_ - 1) / stride_;
   for (int gy = 0; gy < grid_h_; ++gy) {
@@ -98,6 +106,7 @@ BallDetector::BallDetector(const ExpectedClassModel& model, double radius_m) : r
       const int u = std::min(gx * stride_ + stride_ / 2, camera.width() - 1);
       const int v = std::min(gy * stride_ + stride_ / 2, camera.height() - 1);
       const size_t pixel = static_cast<size_t>(v) * camera.width() + u;
+      if (camera.ray(pixel).region == PixelRegion::kAboveHorizon) beyond_.push_back(static_cast<uint32_t>(pixel));
       if (camera.ray(pixel).region != PixelRegion::kFloor) continue;
       points_.push_back({static_cast<uint32_t>(gy * grid_w_ + gx), static_cast<uint32_t>(pixel),
                          model.removalRange(pixel), static_cast<uint8_t>(model.removalSector(pixel))});
@@ -112,16 +121,31 @@ uint8_t BallDetector::classOf(const ColorLut& lut, const uint8_t c[3]) const {
   if (k != kUnknown) return k;
   const Eigen::Vector3f color(c[0], c[1], c[2]);
   for (const KnownColor& known : *known_) {
-    if ((known.mean - color).squaredNorm() < known.radius_sq) return kGreen;  // not the ball's
+    const Eigen::Vector3f d = color - known.mean;
+    float sq = d.squaredNorm();
+    if (known.yuv) {
+      sq -= (1.f - known.intensity_weight) * d[0] * d[0];
+    } else {
+      const float sum = d.sum();
+      sq -= (1.f - known.intensity_weight) * sum * sum / 3.f;
+    }
+    if (sq < known.radius_sq) return kGreen;  // not the ball's
   }
   return kUnknown;
 }
 
 void BallDetector::detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
-                          const SafeRanges& safe, const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs) {
+                          const SafeRanges& safe, const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs,
+                          std::vector<uint32_t>* off_field_ball) {
   blobs->clear();
+  off_field_ball->clear();
   known_ = &known;
   const int width = image.width;
+  auto tableClass = [&](uint32_t pixel) {
+    uint8_t c[3];
+    image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
+    return lut.classOf(c[0], c[1], c[2]);
+  };
   // The grid's classes.
   for (const GridPoint& p : points_) {
     uint8_t g = kGridOff;
@@ -130,8 +154,13 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
       image.color(static_cast<int>(p.pixel % width), static_cast<int>(p.pixel / width), c);
       const uint8_t k = classOf(lut, c);
       g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
+    } else if (tableClass(p.pixel) == kOrange) {
+      off_field_ball->push_back(p.pixel);
     }
     grid_[p.cell] = g;
+  }
+  for (const uint32_t pixel : beyond_) {
+    if (tableClass(pixel) == kOrange) off_field_ball->push_back(pixel);
   }
   // Connected components of ball grid points (8-neighbourhood), the largest first.
   struct Component {
@@ -200,20 +229,47 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
     v0 = std::min(v0, v);
     v1 = std::max(v1, v);
   }
-  u0 = std::max(0, u0 - stride_);
-  v0 = std::max(0, v0 - stride_);
-  u1 = std::min(width - 1, u1 + stride_);
-  v1 = std::min(height - 1, v1 + stride_);
+  // The grid points lie surely on the carpet; the ball's far part may be seen beyond its edge
+  // (onCarpet's reach): the blob may grow by the ball's expected extent around them, through
+  // colors near the grid points' own (not into the hall's floor behind the ball).
+  int margin = stride_;
+  {
+    const uint32_t s = seeds[seeds.size() / 2];
+    BallGeometry::Image im;
+    if (geometry.expected(model.removalRange(s), &im)) {
+      margin += static_cast<int>(std::ceil(0.5 * std::max(im.radial_px, im.tangential_px)));
+    }
+  }
+  u0 = std::max(0, u0 - margin);
+  v0 = std::max(0, v0 - margin);
+  u1 = std::min(width - 1, u1 + margin);
+  v1 = std::min(height - 1, v1 + margin);
+  Eigen::Vector3d seed_mean(0, 0, 0);
+  for (const uint32_t s : seeds) {
+    uint8_t c[3];
+    image.color(static_cast<int>(s % width), static_cast<int>(s / width), c);
+    seed_mean += Eigen::Vector3d(c[0], c[1], c[2]);
+  }
+  seed_mean /= static_cast<double>(seeds.size());
+  double seed_sq = 0;
+  for (const uint32_t s : seeds) {
+    uint8_t c[3];
+    image.color(static_cast<int>(s % width), static_cast<int>(s / width), c);
+    seed_sq += (Eigen::Vector3d(c[0], c[1], c[2]) - seed_mean).squaredNorm();
+  }
+  const double seed_spread = std::sqrt(seed_sq / std::max<size_t>(1, seeds.size() - 1));
+  const double grow_radius = std::max(kGrowMinRadius, kGrowSpreads * seed_spread);
   // window_: -1 not looked at, 0 looked at and not in the blob, 1 in the blob.
   auto look = [&](uint32_t pixel) {
     int32_t& mark = window_[pixel];
     if (mark >= 0) return false;
     mark = 0;
-    if (!onCarpet(model, pixel, safe)) return false;
+    if (!onCarpet(model, pixel, safe, reach_)) return false;
     uint8_t c[3];
     image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
     const uint8_t k = classOf(lut, c);
     if (!ballCandidate(k)) return false;
+    if ((Eigen::Vector3d(c[0], c[1], c[2]) - seed_mean).norm() > grow_radius) return false;
     mark = 1;
     if (k == kOrange) ++blob->ball_cells;
     return true;
@@ -329,12 +385,11 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
     for (int u = std::max(0, bu0 - grow); u <= std::min(width - 1, bu1 + grow); ++u) {
       const size_t p = static_cast<size_t>(v) * width + u;
       if (window_[p] == 1) continue;
-      const PixelRegion region = model.camera().ray(p).region;
-      if (region == PixelRegion::kNotImaged || region == PixelRegion::kSelf) continue;
+      if (!onCarpet(model, p, safe, 1.0)) continue;  // behind a ball near the edge: the hall
       ++around;
       uint8_t c[3];
       image.color(u, v, c);
-      const uint8_t k = lut.classOf(c[0], c[1], c[2]);
+      const uint8_t k = classOf(lut, c);
       carpet += k == kGreen || k == kWhite;
     }
   }

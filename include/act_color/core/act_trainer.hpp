@@ -169,7 +169,7 @@ class ActTrainer {
   // Light compensation: the map moves every cluster and every table cell.
   void applyLightChange(const LightModel::Map& map);
   // The ball stage (ActParams::ball_training), after 2.3; needs sector_safe_range_ of the pose.
-  void trainBall(const ImageView& image, CycleStats& stats);
+  void trainBall(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
 
   struct Evidence {
     float in_field = 0.f;
@@ -246,6 +246,7 @@ class ActTrainer {
   BallDetector ball_detector_;
   std::vector<BallBlob> ball_blobs_;
   std::vector<BallDetector::KnownColor> ball_known_colors_;
+  std::vector<uint32_t> ball_off_field_;
   struct BallHypothesis {
     Eigen::Vector3d mean;
     double spread = 0;

@@ -51,7 +51,7 @@ struct BallBlob {
   // Measured over expected (BallGeometry::expected at distance_m).
   double radial_ratio = 0, tangential_ratio = 0, area_ratio = 0;
   double fill = 0;      // pixels over the ellipse of the measured extents
-  double surround = 0;  // of the pixels around the blob, the fraction classified green or white
+  double surround = 0;  // of the pixels around the blob surely on the carpet, the fraction green or white
   Eigen::Vector3d median{0, 0, 0};  // per-channel median color
   double spread = 0;                // RMS distance of the colors to their mean (as eq. 5's sigma)
   std::vector<uint32_t> members;    // pixel indices (row-major), for training
@@ -68,16 +68,22 @@ class BallDetector {
   BallDetector(const ExpectedClassModel& model, double radius_m);
 
   // A color a trained class's cluster includes: pixels unknown to the table but of such a color
-  // (the carpet in a shadow not yet trained) are not the ball's.
+  // (the carpet in a shadow not yet trained) are not the ball's. The distance weighs the intensity
+  // difference by `intensity_weight` (as the trainer's nearest-mean rule): a darker carpet is carpet.
   struct KnownColor {
     Eigen::Vector3f mean;
     float radius_sq;
+    float intensity_weight = 1.f;
+    bool yuv = false;  // channel 0 is the intensity; else it is the channels' mean
   };
   // Blobs of this image at this pose; `sector_safe_range` from ExpectedClassModel::sectorSafeRanges.
   // Blobs far larger than any ball image are skipped.
+  // Also lists the grid's pixels that may be off the field and are classified as the ball
+  // (`off_field_ball`): the ball is small, the hall large, and the removal step's sparse samples
+  // learn too slowly which of its colors the hall shares; each stands for stride()^2 pixels.
   void detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
               const std::array<double, ExpectedClassModel::kRemovalSectors>& sector_safe_range,
-              const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs);
+              const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs, std::vector<uint32_t>* off_field_ball);
 
   double radius() const { return radius_m_; }
   int stride() const { return stride_; }
@@ -93,6 +99,7 @@ class BallDetector {
 
   double radius_m_;
   int stride_ = 3;
+  double reach_ = 1.0;  // floor range over the carpet's safe range that a ball's pixels can have
   int grid_w_ = 0, grid_h_ = 0;
   double max_area_px_ = 0;  // the largest ball image on the carpet
   struct GridPoint {
@@ -102,6 +109,7 @@ class BallDetector {
     uint8_t sector;
   };
   std::vector<GridPoint> points_;  // the grid's floor pixels
+  std::vector<uint32_t> beyond_;   // the grid's pixels above the horizon
   // Per-cycle scratch.
   std::vector<uint8_t> grid_;
   std::vector<uint32_t> stack_;
