@@ -302,8 +302,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     setCell(cell, k);
     ++changed;
   }
-  // The ball is small: the cells around its colors are more often something else's (a hall poster).
-  const int n = subordinate ? 0 : params_.add_neighbourhood_cells;
+  const int n = params_.add_neighbourhood_cells;
   if (n == 0) return changed;
   // The neighbourhood of a cell confirmed in the last few cycles was filled with a cluster that
   // has hardly moved since (eta = 4): it is filled again only every kNeighbourhoodRefreshCycles.
@@ -324,9 +323,14 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
         if (distance >= radius) continue;
         if (claimedByOtherClass(centre, current, k)) continue;
         if (nearerToOtherMean(centre, k)) continue;
+        if (subordinate && params_.evidence_removal_ratio > 0) {
+          // The ball's neighbourhood keeps what was seen of its colors: one seen off the field stays out.
+          if (evidence(neighbour).off_field > 0) continue;
+        } else if (params_.evidence_removal_ratio > 0) {
+          evidence_[neighbour] = Evidence{0.f, 0.f, this_cycle};
+        }
         setCell(neighbour, k);
         neighbour_only_[neighbour] = 1;
-        if (params_.evidence_removal_ratio > 0) evidence_[neighbour] = Evidence{0.f, 0.f, this_cycle};
         ++changed;
       }
     }
@@ -678,7 +682,8 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   const double green_radius = params_.zeta * clusters_[kGreen].sigma();
   ball_known_colors_.assign(1, {clusters_[kGreen].mean().cast<float>(), static_cast<float>(green_radius * green_radius),
                                 static_cast<float>(kIntensityWeight), lut_.colorSpace() == ColorSpace::kYuv});
-  ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_, &ball_off_field_);
+  ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_, &ball_off_field_,
+                        static_cast<uint32_t>(revision_));
   const uint32_t now = static_cast<uint32_t>(revision_ + 1);
   ClassCluster& ball = clusters_[kOrange];
   const ClusterParams cluster_params = clusterParams();
@@ -694,7 +699,7 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
       if (lut_.at(cell) != kOrange) continue;  // removed by an earlier pixel of this cycle
       Evidence& e = evidence(cell);
       e.off_field += weight;
-      if (e.off_field > evidenceRatio(kOrange) * e.in_field) {
+      if (neighbour_only_[cell] || e.off_field > evidenceRatio(kOrange) * e.in_field) {
         removeCell(cell);
         confirmed_[cell] = 0;
         ++stats.removed[kOrange];

@@ -21,7 +21,7 @@ constexpr double kMaxAreaFactor = 2.5;
 // A blob grows through colors within this many of its grid points' spreads of their mean, and at
 // least kGrowMinRadius units (a sphere's shading spans a range of intensities).
 constexpr double kGrowSpreads = 3.0;
-constexpr double kGrowMinRadius = 45.0;
+constexpr double kGrowMinRadius = 30.0;
 // Blobs looked at per cycle at most (the largest first).
 constexpr size_t kMaxBlobs = 8;
 
@@ -136,11 +136,19 @@ uint8_t BallDetector::classOf(const ColorLut& lut, const uint8_t c[3]) const {
 
 void BallDetector::detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
                           const SafeRanges& safe, const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs,
-                          std::vector<uint32_t>* off_field_ball) {
+                          std::vector<uint32_t>* off_field_ball, uint32_t phase) {
   blobs->clear();
   off_field_ball->clear();
   known_ = &known;
   const int width = image.width;
+  // The look off the field moves within the grid's cells from cycle to cycle.
+  const int du = static_cast<int>(phase % stride_), dv = static_cast<int>((phase / stride_) % stride_);
+  auto shifted = [&](uint32_t pixel, uint32_t* out) {
+    const int u = static_cast<int>(pixel % width) - stride_ / 2 + du, v = static_cast<int>(pixel / width) - stride_ / 2 + dv;
+    if (u < 0 || v < 0 || u >= width || v >= image.height) return false;
+    *out = static_cast<uint32_t>(v * width + u);
+    return true;
+  };
   auto tableClass = [&](uint32_t pixel) {
     uint8_t c[3];
     image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
@@ -154,13 +162,15 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
       image.color(static_cast<int>(p.pixel % width), static_cast<int>(p.pixel / width), c);
       const uint8_t k = classOf(lut, c);
       g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
-    } else if (tableClass(p.pixel) == kOrange) {
-      off_field_ball->push_back(p.pixel);
+    } else {
+      uint32_t q;
+      if (shifted(p.pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
     }
     grid_[p.cell] = g;
   }
   for (const uint32_t pixel : beyond_) {
-    if (tableClass(pixel) == kOrange) off_field_ball->push_back(pixel);
+    uint32_t q;
+    if (shifted(pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
   }
   // Connected components of ball grid points (8-neighbourhood), the largest first.
   struct Component {

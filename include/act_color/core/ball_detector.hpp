@@ -80,10 +80,12 @@ class BallDetector {
   // Blobs far larger than any ball image are skipped.
   // Also lists the grid's pixels that may be off the field and are classified as the ball
   // (`off_field_ball`): the ball is small, the hall large, and the removal step's sparse samples
-  // learn too slowly which of its colors the hall shares; each stands for stride()^2 pixels.
+  // learn too slowly which of its colors the hall shares; each stands for stride()^2 pixels. They
+  // lie at the grid points shifted by `phase` (the cycle): over stride()^2 cycles every pixel.
   void detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
               const std::array<double, ExpectedClassModel::kRemovalSectors>& sector_safe_range,
-              const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs, std::vector<uint32_t>* off_field_ball);
+              const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs, std::vector<uint32_t>* off_field_ball,
+              uint32_t phase);
 
   double radius() const { return radius_m_; }
   int stride() const { return stride_; }
