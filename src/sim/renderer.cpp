@@ -154,6 +154,7 @@ struct Renderer::Impl {
   std::vector<Patch> ceiling_lamps;
 
   Material carpet, line, yellow_goal, blue_goal, robot, ball, chassis, hall_floor, wall, ceiling;
+  std::optional<Material> ball_patches, robot_marker;
 
   float textured(const Material& m, double a, double b) const {
     const float s = kTexelsPerMetre * m.texture_scale;
@@ -196,6 +197,8 @@ Renderer::Impl::Impl(const core::Calibration& cal, const RendererOptions& option
   blue_goal = look(options.blue_goal, 0.5f, 307.f);
   robot = look(options.robot, 0.7f, 409.f);
   ball = look(options.ball, 1.f, 13.f);
+  if (options.ball_patches) ball_patches = look(*options.ball_patches, 1.f, 17.f);
+  if (options.robot_marker) robot_marker = look(*options.robot_marker, 0.7f, 419.f);
   chassis = look(options.chassis, 3.f, 57.f);
   hall_floor = look(options.hall_floor, 0.25f, 71.f);
   wall = look(options.wall, 0.2f, 83.f);
@@ -682,8 +685,11 @@ LabeledFrame Renderer::render(const Scene& scene) const {
             shade = static_cast<float>(0.6 + 0.2 * nx + 0.05 * ny);
           }
           const double angle = std::atan2(p.y() - ob.y_m, p.x() - ob.x_m);
-          color = im.robot.albedo * (shade * im.textured(im.robot, angle * ob.radius_m + 3.0 * robot_index,
-                                                         robot_top ? p.x() + p.y() : p.z()));
+          // A team marker: a band from 55% to 75% of the robot's height.
+          const bool marker = im.robot_marker && !robot_top && p.z() > 0.55 * ob.height_m && p.z() < 0.75 * ob.height_m;
+          const Material& m = marker ? *im.robot_marker : im.robot;
+          color = m.albedo *
+                  (shade * im.textured(m, angle * ob.radius_m + 3.0 * robot_index, robot_top ? p.x() + p.y() : p.z()));
           illumination = lightAt(p.x(), p.y(), false);
           break;
         }
@@ -709,7 +715,12 @@ LabeledFrame Renderer::render(const Scene& scene) const {
           label = core::kOrange;
           const Eigen::Vector3d normal = (p - ball_center) / scene.ball->radius_m;
           const float shade = static_cast<float>(0.35 + 0.65 * std::max(0.0, 0.3 * normal.x() + 0.95 * normal.z()));
-          color = im.ball.albedo * (shade * im.textured(im.ball, normal.x() * 2.0, normal.y() * 2.0 + normal.z()));
+          // Patches of the second color: where a smooth pattern on the sphere is high (a third of it).
+          const bool patch = im.ball_patches && std::sin(5.0 * normal.x()) * std::sin(5.0 * normal.y() + 1.0) *
+                                                        std::sin(5.0 * normal.z() + 2.0) >
+                                                    0.12;
+          const Material& m = patch ? *im.ball_patches : im.ball;
+          color = m.albedo * (shade * im.textured(m, normal.x() * 2.0, normal.y() * 2.0 + normal.z()));
           illumination = lightAt(ball_center.x(), ball_center.y(), false);
           break;
         }

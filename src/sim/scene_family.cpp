@@ -204,6 +204,50 @@ core::FieldCalibration drawField(Draw& draw) {
   return f;
 }
 
+// The ball's look (issue 13): orange as in 2007, yellow, red, pink, or two colors; a robot team
+// marker of the ball's color or of another; a hall poster of the ball's color. Drawn with their own
+// generator so that the rest of a scene stays as it was before balls had looks. Returns a word.
+std::string drawBallLooks(uint32_t seed, RendererOptions* o) {
+  Draw draw(seed * 2654435761u + 0xba11u);
+  std::string kind;
+  switch (draw.weighted({0.35, 0.25, 0.15, 0.1, 0.15})) {
+    case 0:
+      kind = "orange";
+      break;  // as drawLooks drew it
+    case 1:
+      kind = "yellow";
+      o->ball.rgb = Eigen::Vector3d(draw.uniform(225, 250), draw.uniform(215, 245), draw.uniform(30, 110));
+      break;
+    case 2:
+      kind = "red";
+      o->ball.rgb = Eigen::Vector3d(draw.uniform(195, 235), draw.uniform(25, 60), draw.uniform(30, 70));
+      break;
+    case 3:
+      kind = "pink";
+      o->ball.rgb = Eigen::Vector3d(draw.uniform(225, 250), draw.uniform(90, 140), draw.uniform(160, 210));
+      break;
+    default:
+      kind = "two-colour";
+      o->ball_patches = SurfaceLook{draw.chance(0.5) ? Eigen::Vector3d(draw.uniform(190, 230), 40, 50)
+                                                     : Eigen::Vector3d(40, 70, draw.uniform(170, 220)),
+                                    0.06f};
+      break;
+  }
+  // A hall poster or box of the ball's color: one of the random clutter colors takes it.
+  if (draw.chance(0.35) && o->clutter_palette.size() > 7) {
+    o->clutter_palette.back() = draw.jitter(o->ball.rgb, 12);
+    kind += ", poster";
+  }
+  if (draw.chance(0.3)) {
+    o->robot_marker = SurfaceLook{draw.jitter(o->ball.rgb, 15), 0.06f};
+    kind += ", markers of its color";
+  } else if (draw.chance(0.25)) {
+    o->robot_marker = SurfaceLook{draw.chance(0.5) ? Eigen::Vector3d(235, 70, 190) : Eigen::Vector3d(60, 210, 225), 0.06f};
+    kind += ", markers";
+  }
+  return kind;
+}
+
 // Materials, hall and the clutter palette. Returns a short description.
 void drawLooks(Draw& draw, RendererOptions* o) {
   static const std::vector<Eigen::Vector3d> kCarpets = {
@@ -543,6 +587,7 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length) {
   RendererOptions& options = out.renderer;
   options.hall_seed = seed * 2654435761u + 17u;
   drawLooks(draw, &options);
+  const std::string ball_looks = drawBallLooks(seed, &options);
   options.struts = drawStruts(draw, out.calibration.camera);
   const Lighting base_light = drawLighting(draw, field);
 
@@ -647,20 +692,37 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length) {
   double ball_vx = 0.0, ball_vy = 0.0;
   if (draw.chance(0.55)) {
     const bool rolling = draw.chance(0.4);
+    auto clear = [&](const Ball& b, double vx, double vy) {
+      bool ok = true;
+      for (int i = 0; i < total && ok; ++i) {
+        const double x = b.x_m + vx * i / kFrameRateHz, y = b.y_m + vy * i / kFrameRateHz;
+        ok = std::hypot(x - truth[i].x_m, y - truth[i].y_m) >= kMinBallDistanceM && std::abs(x) < hl + 0.2 &&
+             std::abs(y) < hw + 0.2;
+        for (const RobotObstacle& r : robots) ok = ok && std::hypot(x - r.x_m, y - r.y_m) > r.radius_m + 0.15;
+      }
+      return ok;
+    };
     for (int attempt = 0; attempt < 100 && !ball; ++attempt) {
       Ball b{draw.uniform(-hl + 0.3, hl - 0.3), draw.uniform(-hw + 0.3, hw - 0.3), draw.uniform(0.1, 0.12)};
       const double vx = rolling ? draw.uniform(-0.4, 0.4) : 0.0, vy = rolling ? draw.uniform(-0.4, 0.4) : 0.0;
-      bool clear = true;
-      for (int i = 0; i < total && clear; ++i) {
-        const double x = b.x_m + vx * i / kFrameRateHz, y = b.y_m + vy * i / kFrameRateHz;
-        clear = std::hypot(x - truth[i].x_m, y - truth[i].y_m) >= kMinBallDistanceM && std::abs(x) < hl + 0.2 &&
-                std::abs(y) < hw + 0.2;
-        for (const RobotObstacle& r : robots) clear = clear && std::hypot(x - r.x_m, y - r.y_m) > r.radius_m + 0.15;
-      }
-      if (clear) {
+      if (clear(b, vx, vy)) {
         ball = b;
         ball_vx = vx;
         ball_vy = vy;
+      }
+    }
+    // Partly hidden: in a quarter of the scenes the ball lies just behind a robot as seen from the
+    // first pose (its own generator: the rest of the scene stays as it was).
+    Draw hide(seed * 2246822519u + 0x41deu);
+    if (ball && !robots.empty() && hide.chance(0.25)) {
+      const RobotObstacle& r = robots[static_cast<size_t>(hide.integer(0, static_cast<int>(robots.size()) - 1))];
+      const double dx = r.x_m - truth[0].x_m, dy = r.y_m - truth[0].y_m, d = std::hypot(dx, dy);
+      const double behind = r.radius_m + hide.uniform(0.17, 0.3);
+      const double side = hide.sign() * r.radius_m * hide.uniform(0.6, 1.0);  // the ball shows beside it
+      Ball b{r.x_m + (dx * behind - dy * side) / d, r.y_m + (dy * behind + dx * side) / d, ball->radius_m};
+      if (d > 0 && clear(b, 0.0, 0.0)) {
+        ball = b;
+        ball_vx = ball_vy = 0.0;
       }
     }
   }
@@ -716,7 +778,7 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length) {
       "%zu robots%s, noise %.1f, %s, %d frames, events:%s",
       seed, c.width, c.height, camera_info.profile.c_str(), c.mirror_radius_px, c.height_m, field.length_m,
       field.width_m, options.hall_wall_distance_m, options.struts.size(), people.size(), robots.size(),
-      ball ? ", ball" : "", base_light.noise_sigma,
+      ball ? (", " + ball_looks + " ball").c_str() : "", base_light.noise_sigma,
       driving_from_start ? "driving" : (drive_start < total ? "static then driving" : "static"), total,
       event_text.c_str());
   out.summary = text;

@@ -24,7 +24,7 @@ struct RobotObstacle {
   double height_m = 0.8;
 };
 
-// The ball: an orange sphere lying on the floor.
+// The ball: a sphere lying on the floor (RendererOptions::ball, ball_patches: its look).
 struct Ball {
   double x_m = 0.0;
   double y_m = 0.0;
@@ -126,6 +126,10 @@ struct RendererOptions {
   SurfaceLook blue_goal{{28.0, 72.0, 192.0}, 0.08f};
   SurfaceLook robot{{34.0, 34.0, 38.0}, 0.35f};
   SurfaceLook ball{{240.0, 108.0, 22.0}, 0.06f};
+  // A ball of two colors: patches of this one (about a third of the surface) on `ball`.
+  std::optional<SurfaceLook> ball_patches;
+  // A band of this color around every other robot (a team marker; truth black, it is the robot).
+  std::optional<SurfaceLook> robot_marker;
   SurfaceLook chassis{{30.0, 30.0, 33.0}, 0.3f};
   SurfaceLook hall_floor{{150.0, 142.0, 128.0}, 0.3f};
   SurfaceLook wall{{196.0, 190.0, 176.0}, 0.15f};
