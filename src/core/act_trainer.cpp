@@ -655,8 +655,8 @@ namespace {
 // Ball blobs, measured over what a ball at their distance would show (BallGeometry).
 // The shape of a sighting of the ball: partly hidden balls (by a robot, the mirror's rim) count.
 bool ballSighting(const BallBlob& b) {
-  return b.pixels >= 4 && b.area_ratio >= 0.25 && b.area_ratio <= 1.8 && b.radial_ratio <= 1.6 &&
-         b.tangential_ratio <= 1.6 && b.fill >= 0.4;
+  return b.pixels >= 4 && b.area_ratio >= 0.25 && b.area_ratio <= 1.8 && b.radial_ratio <= 2.0 &&
+         b.tangential_ratio <= 2.0 && b.fill >= 0.4;
 }
 // Evidence for a ball color not yet trained: a whole ball resting on the carpet.
 bool ballCandidate(const BallBlob& b) {
@@ -670,7 +670,7 @@ constexpr uint32_t kBallMemoryCycles = 15;
 constexpr double kBallMatchSpreads = 2.5;
 constexpr double kBallMatchMin = 20.0;
 // Colors of a sighting added per cycle at most (every n-th of the blob's pixels).
-constexpr size_t kBallAddsPerCycle = 256;
+constexpr size_t kBallAddsPerCycle = 96;
 
 }  // namespace
 
@@ -682,10 +682,10 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   const double green_radius = params_.zeta * clusters_[kGreen].sigma();
   ball_known_colors_.assign(1, {clusters_[kGreen].mean().cast<float>(), static_cast<float>(green_radius * green_radius),
                                 static_cast<float>(kIntensityWeight), lut_.colorSpace() == ColorSpace::kYuv});
-  ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_, &ball_off_field_,
-                        static_cast<uint32_t>(revision_));
-  const uint32_t now = static_cast<uint32_t>(revision_ + 1);
   ClassCluster& ball = clusters_[kOrange];
+  ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_, &ball_off_field_,
+                        static_cast<uint32_t>(revision_), ball.trained() && params_.evidence_removal_ratio > 0);
+  const uint32_t now = static_cast<uint32_t>(revision_ + 1);
   const ClusterParams cluster_params = clusterParams();
 
   // 2.4's evidence for the ball's colors, from the detector's denser look off the field.
@@ -778,8 +778,9 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
     bool new_place = match->places.size() < static_cast<size_t>(kBallSeedPlaces);
     for (const Eigen::Vector2d& q : match->places) new_place = new_place && (q - place).norm() >= kBallPlaceSpacingM;
     if (new_place) match->places.push_back(place);
-    const bool enough = match->frames >= kBallSeedFrames &&
-                        (static_cast<int>(match->places.size()) >= kBallSeedPlaces || match->frames >= 2 * kBallSeedFrames);
+    const bool enough =
+        match->frames >= kBallSeedFrames &&
+        (static_cast<int>(match->places.size()) >= kBallSeedPlaces || match->frames >= 2 * kBallSeedFrames);
     if (enough && ball_lost && !seen) {
       ball.set(match->mean, std::max(params_.sigma_min, match->spread), true);
       stats.ball_seeded = true;
@@ -889,7 +890,17 @@ const ActTrainer::RemovalSamples& ActTrainer::removalSamples(size_t start) {
 }
 
 void ActTrainer::bootstrap(const ImageView& image, const Pose2D& pose, int cycles) {
-  for (int i = 0; i < cycles; ++i) cycle(image, pose);
+  // One image many times is one sighting of a ball: the ball stage looks at it in the last cycle
+  // only (and the start-up training stays well within a frame's time).
+  struct Restore {
+    bool& flag;
+    const bool value;
+    ~Restore() { flag = value; }
+  } restore{params_.ball_training, params_.ball_training};
+  for (int i = 0; i < cycles; ++i) {
+    params_.ball_training = restore.value && i + 1 == cycles;
+    cycle(image, pose);
+  }
 }
 
 }  // namespace core

@@ -9,10 +9,11 @@ namespace core {
 namespace {
 
 // The grid is spaced so that the smallest ball image on the carpet spans this many grid points
-// across its narrower extent.
-constexpr double kGridPointsAcrossBall = 2.0;
-constexpr int kMinGridStride = 2;  // a ball of fewer pixels is still found when one grid point hits it
-constexpr int kMaxGridStride = 4;
+// across its narrower extent (one hit is enough: the blob is grown at full resolution). The grid
+// is most of the stage's cost.
+constexpr double kGridPointsAcrossBall = 1.0;
+constexpr int kMinGridStride = 4;
+constexpr int kMaxGridStride = 8;
 // Ground distances over which the grid spacing and the largest ball image are computed.
 constexpr double kNearestDistanceM = 0.3;
 constexpr double kDistanceStepM = 0.05;
@@ -25,6 +26,7 @@ constexpr double kGrowMinRadius = 30.0;
 // Blobs looked at per cycle at most (the largest first).
 constexpr size_t kMaxBlobs = 8;
 
+constexpr uint8_t kNoSector = 255;   // BallDetector::sectors_ of a pixel that does not see the floor
 constexpr uint8_t kGridOff = 0;      // not on the carpet, or not a grid point
 constexpr uint8_t kGridBall = 1;     // unknown or the ball's class
 constexpr uint8_t kGridCarpet = 2;   // green or white
@@ -73,10 +75,11 @@ namespace {
 // A ball on the carpet: its pixels' view rays pass over the carpet at the ball's top, 2 radii up.
 // Their floor points lie up to height / (height - 2 radii) times as far (a ball near a line at
 // the field's edge reaches far beyond it in the image).
-bool onCarpet(const ExpectedClassModel& model, size_t pixel,
+bool onCarpet(const ExpectedClassModel& model, const std::vector<uint8_t>& sectors, size_t pixel,
               const std::array<double, ExpectedClassModel::kRemovalSectors>& safe, double reach) {
-  if (model.camera().ray(pixel).region != PixelRegion::kFloor) return false;
-  return model.removalRange(pixel) < reach * safe[static_cast<size_t>(model.removalSector(pixel))];
+  const uint8_t sector = sectors[pixel];
+  if (sector == kNoSector) return false;
+  return model.removalRange(pixel) < reach * safe[sector];
 }
 
 }  // namespace
@@ -113,6 +116,10 @@ BallDetector::BallDetector(const ExpectedClassModel& model, double radius_m) : r
     }
   }
   grid_.assign(static_cast<size_t>(grid_w_) * grid_h_, kGridOff);
+  sectors_.assign(model.pixels(), kNoSector);
+  for (size_t i = 0; i < model.pixels(); ++i) {
+    if (camera.ray(i).region == PixelRegion::kFloor) sectors_[i] = static_cast<uint8_t>(model.removalSector(i));
+  }
   window_.assign(model.pixels(), -1);
 }
 
@@ -136,7 +143,7 @@ uint8_t BallDetector::classOf(const ColorLut& lut, const uint8_t c[3]) const {
 
 void BallDetector::detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
                           const SafeRanges& safe, const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs,
-                          std::vector<uint32_t>* off_field_ball, uint32_t phase) {
+                          std::vector<uint32_t>* off_field_ball, uint32_t phase, bool look_off_field) {
   blobs->clear();
   off_field_ball->clear();
   known_ = &known;
@@ -144,7 +151,8 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
   // The look off the field moves within the grid's cells from cycle to cycle.
   const int du = static_cast<int>(phase % stride_), dv = static_cast<int>((phase / stride_) % stride_);
   auto shifted = [&](uint32_t pixel, uint32_t* out) {
-    const int u = static_cast<int>(pixel % width) - stride_ / 2 + du, v = static_cast<int>(pixel / width) - stride_ / 2 + dv;
+    const int u = static_cast<int>(pixel % width) - stride_ / 2 + du,
+              v = static_cast<int>(pixel / width) - stride_ / 2 + dv;
     if (u < 0 || v < 0 || u >= width || v >= image.height) return false;
     *out = static_cast<uint32_t>(v * width + u);
     return true;
@@ -162,15 +170,17 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
       image.color(static_cast<int>(p.pixel % width), static_cast<int>(p.pixel / width), c);
       const uint8_t k = classOf(lut, c);
       g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
-    } else {
+    } else if (look_off_field) {
       uint32_t q;
       if (shifted(p.pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
     }
     grid_[p.cell] = g;
   }
-  for (const uint32_t pixel : beyond_) {
-    uint32_t q;
-    if (shifted(pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
+  if (look_off_field) {
+    for (const uint32_t pixel : beyond_) {
+      uint32_t q;
+      if (shifted(pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
+    }
   }
   // Connected components of ball grid points (8-neighbourhood), the largest first.
   struct Component {
@@ -274,7 +284,7 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
     int32_t& mark = window_[pixel];
     if (mark >= 0) return false;
     mark = 0;
-    if (!onCarpet(model, pixel, safe, reach_)) return false;
+    if (!onCarpet(model, sectors_, pixel, safe, reach_)) return false;
     uint8_t c[3];
     image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
     const uint8_t k = classOf(lut, c);
@@ -319,24 +329,23 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
   blob->centroid_u = su / blob->pixels;
   blob->centroid_v = sv / blob->pixels;
   const double phi_c = std::atan2(blob->centroid_v - cal.center_v, blob->centroid_u - cal.center_u);
-  double r_min = std::numeric_limits<double>::infinity(), r_max = 0, a_min = 0, a_max = 0, r_sum = 0;
+  // Across the radius: the offset along the tangent at the centroid (a ball is small against its
+  // distance from the mirror's axis).
+  const double tu = -std::sin(phi_c), tv = std::cos(phi_c);
+  double r_min = std::numeric_limits<double>::infinity(), r_max = 0, t_min = 0, t_max = 0;
   for (const uint32_t p : blob->members) {
     const double du = static_cast<double>(p % width) - cal.center_u, dv = static_cast<double>(p / width) - cal.center_v;
-    const double r = std::hypot(du, dv);
-    double a = std::atan2(dv, du) - phi_c;
-    if (a > M_PI) a -= 2 * M_PI;
-    if (a < -M_PI) a += 2 * M_PI;
+    const double r = std::sqrt(du * du + dv * dv);
+    const double t = (du - (blob->centroid_u - cal.center_u)) * tu + (dv - (blob->centroid_v - cal.center_v)) * tv;
     r_min = std::min(r_min, r);
     r_max = std::max(r_max, r);
-    a_min = std::min(a_min, a);
-    a_max = std::max(a_max, a);
-    r_sum += r;
+    t_min = std::min(t_min, t);
+    t_max = std::max(t_max, t);
   }
   blob->r_near_px = r_min - 0.5;
   blob->r_far_px = r_max + 0.5;
-  const double r_c = r_sum / blob->pixels;
   const double radial = blob->r_far_px - blob->r_near_px;
-  const double tangential = (a_max - a_min) * r_c + 1.0;
+  const double tangential = t_max - t_min + 1.0;
   blob->fill = blob->pixels / (M_PI / 4.0 * radial * tangential);
   blob->distance_m = geometry.distanceFromRadii(blob->r_near_px, blob->r_far_px);
   const double bearing = cal.bearing_sign * phi_c + cal.bearing_offset_rad;
@@ -391,11 +400,11 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
     bv1 = std::max(bv1, v);
   }
   uint32_t around = 0, carpet = 0;
-  for (int v = std::max(0, bv0 - grow); v <= std::min(height - 1, bv1 + grow); ++v) {
-    for (int u = std::max(0, bu0 - grow); u <= std::min(width - 1, bu1 + grow); ++u) {
+  for (int v = std::max(0, bv0 - grow); v <= std::min(height - 1, bv1 + grow); v += 2) {  // every other
+    for (int u = std::max(0, bu0 - grow); u <= std::min(width - 1, bu1 + grow); u += 2) {
       const size_t p = static_cast<size_t>(v) * width + u;
       if (window_[p] == 1) continue;
-      if (!onCarpet(model, p, safe, 1.0)) continue;  // behind a ball near the edge: the hall
+      if (!onCarpet(model, sectors_, p, safe, 1.0)) continue;  // behind a ball near the edge: the hall
       ++around;
       uint8_t c[3];
       image.color(u, v, c);

@@ -4,6 +4,7 @@
 #include <cv_bridge/cv_bridge.h>
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
+#include <geometry_msgs/PointStamped.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
@@ -56,7 +57,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::Subscriber image_sub_;
   image_transport::Publisher classified_pub_;
-  ros::Publisher lut_pub_, debug_pub_;
+  ros::Publisher lut_pub_, debug_pub_, ball_pub_;
+  std::string base_frame_;
   ros::ServiceServer save_srv_, load_srv_;
   std::unique_ptr<dynamic_reconfigure::Server<ActTrainerConfig>> reconfigure_server_;
   boost::recursive_mutex reconfigure_mutex_;
@@ -127,6 +129,8 @@ bool ActTrainerNodelet::configure(std::string* error) {
   params.robots_train_black = pnh_.param("robots_train_black", params.robots_train_black);
   params.nearest_mean = pnh_.param("nearest_mean", params.nearest_mean);
   params.evidence_removal_ratio = pnh_.param("evidence_removal_ratio", params.evidence_removal_ratio);
+  params.ball_training = pnh_.param("ball_training", params.ball_training);
+  params.ball_diameter_m = pnh_.param("ball_diameter_m", params.ball_diameter_m);
   // Extensions removed because the randomized scene family showed they did not help (issue 11):
   // a launch file that still sets them is told once instead of being ignored silently.
   for (const char* removed : {"seed_clusters", "robust_clusters"}) {
@@ -177,6 +181,9 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // The table is published as an immutable shared message: in the same manager, subscribers get
   // this very object (zero copy).
   lut_pub_ = nh_.advertise<act_color::ColorLut>("color_lut", 2);
+  // The ball on the carpet (ActParams::ball_training), in base_link, only when seen.
+  ball_pub_ = nh_.advertise<geometry_msgs::PointStamped>("ball", 5);
+  base_frame_ = pnh_.param<std::string>("base_frame", "base_link");
   if (debug_addresses_) debug_pub_ = pnh_.advertise<std_msgs::UInt64MultiArray>("published_lut", 100);
   it_ = std::make_unique<image_transport::ImageTransport>(nh_);
   // Classified only while someone listens (checked per image); training needs every image anyway.
@@ -260,6 +267,15 @@ void ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
   } else if (have_pose) {
     last_stats_ = trainer_->cycle(view, pose);
     trained = true;
+    if (last_stats_.ball.seen) {
+      geometry_msgs::PointStamped ball;
+      ball.header.stamp = msg->header.stamp;
+      ball.header.frame_id = base_frame_;
+      ball.point.x = last_stats_.ball.x_m;
+      ball.point.y = last_stats_.ball.y_m;
+      ball.point.z = 0.0;  // where it rests on the carpet
+      ball_pub_.publish(ball);
+    }
   } else if (may_hold) {
     NODELET_WARN_THROTTLE(5.0, "image stamped %.3f: %s; waiting for the next image", msg->header.stamp.toSec(),
                           why.c_str());

@@ -138,7 +138,8 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
     const core::ImageView view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
     const uint64_t ball_truth = static_cast<uint64_t>(cv::countNonZero(frame.labels == core::kOrange));
     if (ball_truth >= kMinBallTruthPixels && ball_first_in_view == SIZE_MAX) ball_first_in_view = i;
-    const bool count_ball = !f.scene.ball || (ball_first_in_view != SIZE_MAX && i >= ball_first_in_view + kBallFramesInView);
+    const bool count_ball =
+        !f.scene.ball || (ball_first_in_view != SIZE_MAX && i >= ball_first_in_view + kBallFramesInView);
     for (size_t m = 0; m < modes.size(); ++m) {
       for (const std::string& e : f.events) evaluations[m].markEvent(e);
       if (i == 0) trainers[m].bootstrap(view, f.told_pose, std::max(0, options.bootstrap_cycles - 1));

@@ -716,9 +716,9 @@ LabeledFrame Renderer::render(const Scene& scene) const {
           const Eigen::Vector3d normal = (p - ball_center) / scene.ball->radius_m;
           const float shade = static_cast<float>(0.35 + 0.65 * std::max(0.0, 0.3 * normal.x() + 0.95 * normal.z()));
           // Patches of the second color: where a smooth pattern on the sphere is high (a third of it).
-          const bool patch = im.ball_patches && std::sin(5.0 * normal.x()) * std::sin(5.0 * normal.y() + 1.0) *
-                                                        std::sin(5.0 * normal.z() + 2.0) >
-                                                    0.12;
+          const bool patch =
+              im.ball_patches &&
+              std::sin(5.0 * normal.x()) * std::sin(5.0 * normal.y() + 1.0) * std::sin(5.0 * normal.z() + 2.0) > 0.12;
           const Material& m = patch ? *im.ball_patches : im.ball;
           color = m.albedo * (shade * im.textured(m, normal.x() * 2.0, normal.y() * 2.0 + normal.z()));
           illumination = lightAt(ball_center.x(), ball_center.y(), false);

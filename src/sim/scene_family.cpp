@@ -242,7 +242,8 @@ std::string drawBallLooks(uint32_t seed, RendererOptions* o) {
     o->robot_marker = SurfaceLook{draw.jitter(o->ball.rgb, 15), 0.06f};
     kind += ", markers of its color";
   } else if (draw.chance(0.25)) {
-    o->robot_marker = SurfaceLook{draw.chance(0.5) ? Eigen::Vector3d(235, 70, 190) : Eigen::Vector3d(60, 210, 225), 0.06f};
+    o->robot_marker =
+        SurfaceLook{draw.chance(0.5) ? Eigen::Vector3d(235, 70, 190) : Eigen::Vector3d(60, 210, 225), 0.06f};
     kind += ", markers";
   }
   return kind;
@@ -572,7 +573,7 @@ bool isNamedToneChange(const std::string& event) {
   return std::find(kinds.begin(), kinds.begin() + 5, kind) != kinds.begin() + 5;
 }
 
-FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length) {
+FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length, bool ball_looks) {
   Draw draw(seed);
   FamilyScene out;
   out.seed = seed;
@@ -587,7 +588,7 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length) {
   RendererOptions& options = out.renderer;
   options.hall_seed = seed * 2654435761u + 17u;
   drawLooks(draw, &options);
-  const std::string ball_looks = drawBallLooks(seed, &options);
+  const std::string ball_kind = ball_looks ? drawBallLooks(seed, &options) : "orange";
   options.struts = drawStruts(draw, out.calibration.camera);
   const Lighting base_light = drawLighting(draw, field);
 
@@ -711,10 +712,10 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length) {
         ball_vy = vy;
       }
     }
-    // Partly hidden: in a quarter of the scenes the ball lies just behind a robot as seen from the
-    // first pose (its own generator: the rest of the scene stays as it was).
+    // Partly hidden (with the ball looks): in a quarter of the scenes the ball lies just behind a
+    // robot as seen from the first pose (its own generator: the rest of the scene stays as it was).
     Draw hide(seed * 2246822519u + 0x41deu);
-    if (ball && !robots.empty() && hide.chance(0.25)) {
+    if (ball_looks && ball && !robots.empty() && hide.chance(0.25)) {
       const RobotObstacle& r = robots[static_cast<size_t>(hide.integer(0, static_cast<int>(robots.size()) - 1))];
       const double dx = r.x_m - truth[0].x_m, dy = r.y_m - truth[0].y_m, d = std::hypot(dx, dy);
       const double behind = r.radius_m + hide.uniform(0.17, 0.3);
@@ -778,7 +779,7 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length) {
       "%zu robots%s, noise %.1f, %s, %d frames, events:%s",
       seed, c.width, c.height, camera_info.profile.c_str(), c.mirror_radius_px, c.height_m, field.length_m,
       field.width_m, options.hall_wall_distance_m, options.struts.size(), people.size(), robots.size(),
-      ball ? (", " + ball_looks + " ball").c_str() : "", base_light.noise_sigma,
+      ball ? (", " + ball_kind + " ball").c_str() : "", base_light.noise_sigma,
       driving_from_start ? "driving" : (drive_start < total ? "static then driving" : "static"), total,
       event_text.c_str());
   out.summary = text;

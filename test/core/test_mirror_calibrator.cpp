@@ -88,7 +88,7 @@ cv::Mat renderBgr(const sim::FamilyScene& scene) {
 // (0.7 m: ground distances depend only on height and elevation jointly).
 TEST(MirrorCalibrator, FitsRandomSimulatedCameras) {
   for (uint32_t seed : {1000u, 1001u, 1002u, 1004u}) {
-    const sim::FamilyScene scene = sim::makeFamilyScene(seed);
+    const sim::FamilyScene scene = sim::makeFamilyScene(seed, sim::ScenarioLength::kSmall, /*ball_looks=*/false);
     const core::Pose2D truth = scene.scenario.frames.front().scene.robot_pose;
     core::MirrorCalibratorOptions options;
     options.pose = {truth.x_m + 0.3, truth.y_m - 0.2, wrap(truth.theta_rad + 12 * kPi / 180)};
@@ -137,7 +137,7 @@ TEST(MirrorCalibrator, RejectsImagesWithoutAField) {
   const cv::Mat grey(480, 640, CV_8UC3, cv::Scalar(128, 128, 128));
   EXPECT_THROW(calibrator.fit(grey), core::CalibrationFitError);
   // A field image whose lines are painted over (the carpet and the hall stay): no fit.
-  const sim::FamilyScene scene = sim::makeFamilyScene(1002u);
+  const sim::FamilyScene scene = sim::makeFamilyScene(1002u, sim::ScenarioLength::kSmall, /*ball_looks=*/false);
   cv::Mat image = renderBgr(scene);
   cv::Mat hsv, whitish;
   cv::cvtColor(image, hsv, cv::COLOR_BGR2HSV);

@@ -49,7 +49,8 @@ bool exists(const std::string& path) { return static_cast<bool>(std::ifstream(pa
 }  // namespace
 
 TEST(ActCalibrate, FitsASimulatedImageIntoAFileThatLoads) {
-  const sim::FamilyScene scene = sim::makeFamilyScene(1002u);  // 480x480, quick to render and fit
+  const sim::FamilyScene scene = sim::makeFamilyScene(1002u, sim::ScenarioLength::kSmall,
+                                                      /*ball_looks=*/false);  // 480x480, quick to render and fit
   cv::Mat bgr;
   cv::cvtColor(sim::Renderer(scene.calibration, scene.renderer).render(scene.scenario.frames.front().scene).rgb, bgr,
                cv::COLOR_RGB2BGR);

@@ -132,7 +132,8 @@ class ActTrainer {
 
   // One training cycle: cluster update (2.2), additions (2.3), removals (2.4).
   CycleStats cycle(const ImageView& image, const Pose2D& pose);
-  // The start-up table: `cycles` cycles on one image at a known pose (paper, section 2).
+  // The start-up table: `cycles` cycles on one image at a known pose (paper, section 2); the ball
+  // stage runs in the last one only.
   void bootstrap(const ImageView& image, const Pose2D& pose, int cycles);
 
   // New parameters keep the table and clusters unless lut_bits changes.

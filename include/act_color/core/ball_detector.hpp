@@ -50,8 +50,8 @@ struct BallBlob {
   double base_x_m = 0, base_y_m = 0;   // the ball's centre on the carpet, base_link
   // Measured over expected (BallGeometry::expected at distance_m).
   double radial_ratio = 0, tangential_ratio = 0, area_ratio = 0;
-  double fill = 0;      // pixels over the ellipse of the measured extents
-  double surround = 0;  // of the pixels around the blob surely on the carpet, the fraction green or white
+  double fill = 0;                  // pixels over the ellipse of the measured extents
+  double surround = 0;              // of the pixels around the blob surely on the carpet, the fraction green or white
   Eigen::Vector3d median{0, 0, 0};  // per-channel median color
   double spread = 0;                // RMS distance of the colors to their mean (as eq. 5's sigma)
   std::vector<uint32_t> members;    // pixel indices (row-major), for training
@@ -82,10 +82,11 @@ class BallDetector {
   // (`off_field_ball`): the ball is small, the hall large, and the removal step's sparse samples
   // learn too slowly which of its colors the hall shares; each stands for stride()^2 pixels. They
   // lie at the grid points shifted by `phase` (the cycle): over stride()^2 cycles every pixel.
+  // Only with `look_off_field` (a table without ball colors needs none of it).
   void detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
               const std::array<double, ExpectedClassModel::kRemovalSectors>& sector_safe_range,
               const std::vector<KnownColor>& known, std::vector<BallBlob>* blobs, std::vector<uint32_t>* off_field_ball,
-              uint32_t phase);
+              uint32_t phase, bool look_off_field);
 
   double radius() const { return radius_m_; }
   int stride() const { return stride_; }
@@ -112,6 +113,7 @@ class BallDetector {
   };
   std::vector<GridPoint> points_;  // the grid's floor pixels
   std::vector<uint32_t> beyond_;   // the grid's pixels above the horizon
+  std::vector<uint8_t> sectors_;   // every pixel's removal sector (ExpectedClassModel), 255 off the floor
   // Per-cycle scratch.
   std::vector<uint8_t> grid_;
   std::vector<uint32_t> stack_;

@@ -37,7 +37,7 @@ constexpr size_t kBallFramesInView = 30;
 constexpr uint64_t kMinBallTruthPixels = 10;
 struct BallFigures {
   bool ball_in_scene = false;
-  size_t frames = 0;  // counted frames (with a ball: after kBallFramesInView in view)
+  size_t frames = 0;                            // counted frames (with a ball: after kBallFramesInView in view)
   uint64_t truth = 0, predicted = 0, hits = 0;  // ball pixels in the truth, classified, both
   size_t frames_in_view = 0;                    // of the counted frames, with the ball in view
   size_t sightings = 0;                         // of those, with a position reported
@@ -59,7 +59,7 @@ struct SceneResult {
   size_t frames = 0;
   size_t adapt_frames = 12;
   double render_seconds = 0.0;
-  double act_seconds = 0.0;  // training and classification, all modes
+  double act_seconds = 0.0;       // training and classification, all modes
   std::vector<BallFigures> ball;  // [mode]
 };
 

@@ -28,7 +28,10 @@ struct FamilyScene {
   Scenario scenario;              // frames, the poses ACT is told, events
 };
 
-FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length = ScenarioLength::kSmall);
+// `ball_looks` false: the ball orange, plain and where it was, no team markers, no poster of the
+// ball's color (the scenes as they were before issue 13; act_calibrate's simulator check was
+// developed on those).
+FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length = ScenarioLength::kSmall, bool ball_looks = true);
 
 // The kinds of the family's events (ScenarioFrame::events), in a fixed order. The first five are
 // the named sudden changes (tone curves from the event's frame on): "darken" (the paper's
