@@ -302,7 +302,9 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     setCell(cell, k);
     ++changed;
   }
-  const int n = params_.add_neighbourhood_cells;
+  // The ball is small and its colors lie next to the hall's and the goals': its table grows from
+  // its own samples only (neighbour-only cells were most of its false pixels).
+  const int n = subordinate ? 0 : params_.add_neighbourhood_cells;
   if (n == 0) return changed;
   // The neighbourhood of a cell confirmed in the last few cycles was filled with a cluster that
   // has hardly moved since (eta = 4): it is filled again only every kNeighbourhoodRefreshCycles.
@@ -323,12 +325,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
         if (distance >= radius) continue;
         if (claimedByOtherClass(centre, current, k)) continue;
         if (nearerToOtherMean(centre, k)) continue;
-        if (subordinate && params_.evidence_removal_ratio > 0) {
-          // The ball's neighbourhood keeps what was seen of its colors: one seen off the field stays out.
-          if (evidence(neighbour).off_field > 0) continue;
-        } else if (params_.evidence_removal_ratio > 0) {
-          evidence_[neighbour] = Evidence{0.f, 0.f, this_cycle};
-        }
+        if (params_.evidence_removal_ratio > 0) evidence_[neighbour] = Evidence{0.f, 0.f, this_cycle};
         setCell(neighbour, k);
         neighbour_only_[neighbour] = 1;
         ++changed;
@@ -653,16 +650,22 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 namespace {
 
 // Ball blobs, measured over what a ball at their distance would show (BallGeometry).
+constexpr double kBallMinChroma = 20.0;
+constexpr double kBallMinRelativeChroma = 0.25;
+
 // The shape of a sighting of the ball: partly hidden balls (by a robot, the mirror's rim) count.
 bool ballSighting(const BallBlob& b) {
   return b.pixels >= 4 && b.area_ratio >= 0.25 && b.area_ratio <= 1.8 && b.radial_ratio <= 2.0 &&
          b.tangential_ratio <= 2.0 && b.fill >= 0.4;
 }
-// Evidence for a ball color not yet trained: a whole ball resting on the carpet.
+// Evidence for a ball color not yet trained: a whole ball resting on the carpet, of a color (a grey
+// or black ball would be the lines' or the robots' colors; a grey strut of the mirror mount seen
+// through its gaps looked like one).
 bool ballCandidate(const BallBlob& b) {
-  return b.ball_cells == 0 && b.pixels >= 12 && b.radial_ratio >= 0.6 && b.radial_ratio <= 1.6 &&
-         b.tangential_ratio >= 0.6 && b.tangential_ratio <= 1.6 && b.area_ratio >= 0.4 && b.area_ratio <= 1.6 &&
-         b.fill >= 0.55 && b.surround >= 0.6;
+  const double hi = b.median.maxCoeff(), lo = b.median.minCoeff();
+  return hi - lo >= std::max(kBallMinChroma, kBallMinRelativeChroma * hi) && b.ball_cells == 0 && b.pixels >= 8 &&
+         b.radial_ratio >= 0.5 && b.radial_ratio <= 2.0 && b.tangential_ratio >= 0.5 && b.tangential_ratio <= 2.0 &&
+         b.area_ratio >= 0.35 && b.area_ratio <= 2.0 && b.fill >= 0.5 && b.surround >= 0.5;
 }
 // Hypotheses not seen for this many cycles are dropped; a ball not seen for as long may be re-seeded.
 constexpr uint32_t kBallMemoryCycles = 15;
@@ -679,7 +682,9 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   // The carpet as its cluster includes it (2.3's zeta sigma, the intensity weighed as in the
   // nearest-mean rule), where the table does not have it yet (a shadow): a ball's blob does not run
   // into it. (The clusters of lines and goals can be wide enough to include a ball's colors.)
-  const double green_radius = params_.zeta * clusters_[kGreen].sigma();
+  // Green's sigma is capped at 3 sigma_min: on real images the carpet's expected pixels take in
+  // hall and mirror (sigma 60-76 on NuBot's), and such a radius would make every color carpet.
+  const double green_radius = params_.zeta * std::min(clusters_[kGreen].sigma(), 3.0 * params_.sigma_min);
   ball_known_colors_.assign(1, {clusters_[kGreen].mean().cast<float>(), static_cast<float>(green_radius * green_radius),
                                 static_cast<float>(kIntensityWeight), lut_.colorSpace() == ColorSpace::kYuv});
   ClassCluster& ball = clusters_[kOrange];

@@ -162,7 +162,8 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
     image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
     return lut.classOf(c[0], c[1], c[2]);
   };
-  // The grid's classes.
+  // The grid's classes (every floor point is written: last cycle's marks need no clearing).
+  ball_points_.clear();
   for (const GridPoint& p : points_) {
     uint8_t g = kGridOff;
     if (!ExpectedClassModel::mayBeOffField(p.range_m, safe[p.sector])) {
@@ -170,6 +171,7 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
       image.color(static_cast<int>(p.pixel % width), static_cast<int>(p.pixel / width), c);
       const uint8_t k = classOf(lut, c);
       g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
+      if (g == kGridBall) ball_points_.push_back(p.cell);
     } else if (look_off_field) {
       uint32_t q;
       if (shifted(p.pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
@@ -189,11 +191,11 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
   std::vector<Component> components;
   component_.clear();
   const size_t max_points = static_cast<size_t>(kMaxAreaFactor * max_area_px_ / (stride_ * stride_)) + 4;
-  for (const GridPoint& p : points_) {
-    if (grid_[p.cell] != kGridBall) continue;
+  for (const uint32_t start : ball_points_) {
+    if (grid_[start] != kGridBall) continue;
     const size_t begin = component_.size();
-    stack_.assign(1, p.cell);
-    grid_[p.cell] = kGridVisited;
+    stack_.assign(1, start);
+    grid_[start] = kGridVisited;
     while (!stack_.empty()) {
       const uint32_t cell = stack_.back();
       stack_.pop_back();
@@ -216,7 +218,6 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
     }
     components.push_back({begin, component_.size()});
   }
-  for (const GridPoint& p : points_) grid_[p.cell] = kGridOff;
   std::sort(components.begin(), components.end(),
             [](const Component& a, const Component& b) { return a.end - a.begin > b.end - b.begin; });
   if (components.size() > kMaxBlobs) components.resize(kMaxBlobs);

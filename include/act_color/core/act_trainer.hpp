@@ -118,8 +118,8 @@ struct CycleStats {
 // Ball training (ActParams::ball_training): frames of consistent evidence before a color seeds
 // the ball's cluster, and the distinct places (ball positions in base_link kBallPlaceSpacingM
 // apart) among them; at a single place twice the frames are needed.
-constexpr int kBallSeedFrames = 10;
-constexpr int kBallSeedPlaces = 3;
+constexpr int kBallSeedFrames = 6;
+constexpr int kBallSeedPlaces = 2;
 constexpr double kBallPlaceSpacingM = 0.3;
 
 // The ACT algorithm (paper, section 2): one cycle per image and pose.

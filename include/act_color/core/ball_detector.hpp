@@ -116,6 +116,7 @@ class BallDetector {
   std::vector<uint8_t> sectors_;   // every pixel's removal sector (ExpectedClassModel), 255 off the floor
   // Per-cycle scratch.
   std::vector<uint8_t> grid_;
+  std::vector<uint32_t> ball_points_;  // this cycle's grid cells of unknown or ball colors
   std::vector<uint32_t> stack_;
   std::vector<uint32_t> component_;
   std::vector<int32_t> window_;  // full-resolution marks of the blob being grown
