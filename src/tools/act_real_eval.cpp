@@ -102,6 +102,8 @@ int main(int argc, char** argv) {
       return 1;
     }
     image.nubot_table = act_color::sim::readNubotTable(folder + "/CTableBGR.dat");
+    act_color::sim::BallMark ball;
+    if (act_color::sim::readBallMark(folder + "/ball.txt", &ball)) image.ball = ball;
     try {
       image.field = act_color::core::fieldPreset(preset);
     } catch (const std::exception& e) {

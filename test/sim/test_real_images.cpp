@@ -20,6 +20,8 @@ sim::RealImageResult run(const std::string& folder) {
   image.bgr = cv::imread(dir + "/pic_save0.png", cv::IMREAD_COLOR);
   image.whites = core::readNubotWhites(dir + "/whites.txt");
   image.field = core::fieldPreset("lab6x4");
+  sim::BallMark ball;
+  if (sim::readBallMark(dir + "/ball.txt", &ball)) image.ball = ball;
   EXPECT_FALSE(image.bgr.empty());
   EXPECT_GT(image.whites.size(), 1000u);
   return sim::evaluateRealImage(image, {{"defaults", core::ActParams()}});
@@ -42,7 +44,19 @@ void expectHolds(const sim::RealImageResult& r) {
 }
 
 TEST(RealImages, Nubot1) { expectHolds(run("nubot_1")); }
-TEST(RealImages, Nubot1BakBak) { expectHolds(run("nubot_1_bak_bak")); }
+
+TEST(RealImages, Nubot1BakBak) {
+  const sim::RealImageResult r = run("nubot_1_bak_bak");
+  expectHolds(r);
+  // Issue 13 on a real camera: the yellow ball (marked by eye, ball.txt) is learned from the start
+  // image alone and reported where it is. What holds today, short of the issue's 0.80 recall
+  // (measured 0.64 before the change, precision 0.82, reported in 9 of the last 10 frames).
+  for (const auto& row : r.rows) {
+    EXPECT_GE(row.before.ball_recall, 0.5) << row.variant;
+    EXPECT_GE(row.before.ball_precision, 0.75) << row.variant;
+    EXPECT_GE(row.before.ball_seen, 0.8) << row.variant;
+  }
+}
 
 }  // namespace
 }  // namespace act_color

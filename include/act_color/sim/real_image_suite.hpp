@@ -1,6 +1,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,16 @@ namespace sim {
 // and variants of it (the paper's brightness+contrast darkening, a gain of 0.5, gamma 1.6, a warm
 // white balance, a 1.5x brightening) as sequences with fresh noise: kFramesBefore frames of the
 // image, then kFramesAfter of the variant.
+// A ball marked by eye on a real image (ball.txt: "u v semi_major semi_minor angle_deg", the
+// ellipse's centre, half-axes in px and the major axis's angle from +u towards +v).
+struct BallMark {
+  double u = 0, v = 0, a = 0, b = 0, angle_deg = 0;
+  // Inside the ellipse grown by `grow_px` on both axes.
+  bool contains(double x, double y, double grow_px = 0.0) const;
+};
+// Reads ball.txt; false when the file is missing or malformed.
+bool readBallMark(const std::string& path, BallMark* mark);
+
 struct RealImage {
   std::string name;
   cv::Mat bgr;                               // 8-bit, 3 channels, as cv::imread reads it
@@ -24,6 +35,7 @@ struct RealImage {
   // 0 ball, 1 black, 2 green, 3 unknown; no white: their lines are found by brightness); empty when
   // there is none.
   std::vector<uint8_t> nubot_table;
+  std::optional<BallMark> ball;  // the ball marked by eye (issue 13); none when the folder has no ball.txt
   core::FieldCalibration field;
 };
 
@@ -35,6 +47,10 @@ struct RealFrameFigures {
   double white_recall = -1;  // of the hand-picked line pixels classified white (-1: none given)
   double green_recall = 0;   // of the pixels expected carpet inside the outer lines, 3 px from other classes
   double hall_in_field = 0;  // of the pixels expected off the carpet (3 px from it) classified green or white
+  // With a marked ball (-1 without): of the pixels 2 px inside the mark, the fraction classified as the
+  // ball; of the pixels classified as the ball, the fraction within 3 px of the mark (-1: none); 1 when
+  // the trainer reported the ball (CycleStats::ball) with its blob's centroid within 3 px of the mark.
+  double ball_recall = -1, ball_precision = -1, ball_seen = -1;
 };
 
 struct RealVariantResult {
