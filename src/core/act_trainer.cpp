@@ -650,8 +650,8 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 namespace {
 
 // Ball blobs, measured over what a ball at their distance would show (BallGeometry).
-constexpr double kBallMinChroma = 20.0;
-constexpr double kBallMinRelativeChroma = 0.25;
+constexpr double kBallMinChroma = 15.0;
+constexpr double kBallMinRelativeChroma = 0.15;
 
 // The shape of a sighting of the ball: partly hidden balls (by a robot, the mirror's rim) count.
 bool ballSighting(const BallBlob& b) {
@@ -660,15 +660,19 @@ bool ballSighting(const BallBlob& b) {
 }
 // Evidence for a ball color not yet trained: a whole ball resting on the carpet, of a color (a grey
 // or black ball would be the lines' or the robots' colors; a grey strut of the mirror mount seen
-// through its gaps looked like one).
-bool ballCandidate(const BallBlob& b) {
+// through its gaps looked like one). Its pixels are unknown to the table, or, once the ball has
+// been lost (`ball_lost`: after a change of light its colors fall partly in the class, partly not,
+// and the cluster no longer includes them), they may be the ball's too.
+bool ballCandidate(const BallBlob& b, bool ball_lost) {
   const double hi = b.median.maxCoeff(), lo = b.median.minCoeff();
-  return hi - lo >= std::max(kBallMinChroma, kBallMinRelativeChroma * hi) && b.ball_cells == 0 && b.pixels >= 8 &&
-         b.radial_ratio >= 0.5 && b.radial_ratio <= 2.0 && b.tangential_ratio >= 0.5 && b.tangential_ratio <= 2.0 &&
-         b.area_ratio >= 0.35 && b.area_ratio <= 2.0 && b.fill >= 0.5 && b.surround >= 0.5;
+  return hi - lo >= std::max(kBallMinChroma, kBallMinRelativeChroma * hi) && (b.ball_cells == 0 || ball_lost) &&
+         b.pixels >= 8 && b.radial_ratio >= 0.5 && b.radial_ratio <= 2.0 && b.tangential_ratio >= 0.5 &&
+         b.tangential_ratio <= 2.0 && b.area_ratio >= 0.35 && b.area_ratio <= 2.0 && b.fill >= 0.5 && b.surround >= 0.5;
 }
-// Hypotheses not seen for this many cycles are dropped; a ball not seen for as long may be re-seeded.
+// Hypotheses not seen for this many cycles are dropped.
 constexpr uint32_t kBallMemoryCycles = 15;
+// A trained ball not seen for this many cycles is lost: evidence may seed it again.
+constexpr uint32_t kBallLostCycles = 8;
 // A blob's color matches a hypothesis within this many of its spreads, at least kBallMatchMin units.
 constexpr double kBallMatchSpreads = 2.5;
 constexpr double kBallMatchMin = 20.0;
@@ -759,9 +763,9 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   ball_hypotheses_.erase(std::remove_if(ball_hypotheses_.begin(), ball_hypotheses_.end(),
                                         [&](const BallHypothesis& h) { return now - h.last_seen > kBallMemoryCycles; }),
                          ball_hypotheses_.end());
-  const bool ball_lost = !ball.trained() || now - ball_last_seen_ > kBallMemoryCycles;
+  const bool ball_lost = !ball.trained() || now - ball_last_seen_ > kBallLostCycles;
   for (const BallBlob& b : ball_blobs_) {
-    if (&b == seen || !ballCandidate(b)) continue;
+    if (&b == seen || !ballCandidate(b, ball_lost && ball.trained())) continue;
     BallHypothesis* match = nullptr;
     for (BallHypothesis& h : ball_hypotheses_) {
       if ((b.median - h.mean).norm() < std::max(kBallMatchSpreads * h.spread, kBallMatchMin)) match = &h;
