@@ -665,7 +665,7 @@ bool ballSighting(const BallBlob& b) {
 // and the cluster no longer includes them), they may be the ball's too.
 bool ballCandidate(const BallBlob& b, bool ball_lost) {
   const double hi = b.median.maxCoeff(), lo = b.median.minCoeff();
-  return hi - lo >= std::max(kBallMinChroma, kBallMinRelativeChroma * hi) && (b.ball_cells == 0 || ball_lost) &&
+  return hi - lo >= std::max(kBallMinChroma, kBallMinRelativeChroma * hi) && (b.ball_pixels == 0 || ball_lost) &&
          b.pixels >= 8 && b.radial_ratio >= 0.5 && b.radial_ratio <= 2.0 && b.tangential_ratio >= 0.5 &&
          b.tangential_ratio <= 2.0 && b.area_ratio >= 0.35 && b.area_ratio <= 2.0 && b.fill >= 0.5 && b.surround >= 0.5;
 }
@@ -722,9 +722,9 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   const BallBlob* seen = nullptr;
   for (const BallBlob& b : ball_blobs_) {
     if (!ballSighting(b)) continue;
-    if (ball.trained() ? (b.median - ball.mean()).norm() >= params_.zeta * ball.sigma() : b.ball_cells * 2 < b.pixels)
+    if (ball.trained() ? (b.median - ball.mean()).norm() >= params_.zeta * ball.sigma() : b.ball_pixels * 2 < b.pixels)
       continue;
-    if (!seen || std::make_pair(b.ball_cells, b.pixels) > std::make_pair(seen->ball_cells, seen->pixels)) seen = &b;
+    if (!seen || std::make_pair(b.ball_pixels, b.pixels) > std::make_pair(seen->ball_pixels, seen->pixels)) seen = &b;
   }
   auto train = [&](const BallBlob& b) {
     std::vector<Eigen::Vector3f>& colors = samples_[kOrange];
@@ -754,7 +754,7 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
     stats.ball.distance_m = seen->distance_m;
     stats.ball.u = seen->centroid_u;
     stats.ball.v = seen->centroid_v;
-    stats.ball.pixels = seen->ball_cells;
+    stats.ball.pixels = seen->ball_pixels;
     ball_last_seen_ = now;
     train(*seen);
   }

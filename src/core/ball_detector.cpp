@@ -123,11 +123,11 @@ BallDetector::BallDetector(const ExpectedClassModel& model, double radius_m) : r
   window_.assign(model.pixels(), -1);
 }
 
-uint8_t BallDetector::classOf(const ColorLut& lut, const uint8_t c[3]) const {
+uint8_t BallDetector::classOf(const ColorLut& lut, const std::vector<KnownColor>& known_colors, const uint8_t c[3]) {
   const uint8_t k = lut.classOf(c[0], c[1], c[2]);
   if (k != kUnknown) return k;
   const Eigen::Vector3f color(c[0], c[1], c[2]);
-  for (const KnownColor& known : *known_) {
+  for (const KnownColor& known : known_colors) {
     const Eigen::Vector3f d = color - known.mean;
     float sq = d.squaredNorm();
     if (known.yuv) {
@@ -146,7 +146,6 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
                           std::vector<uint32_t>* off_field_ball, uint32_t phase, bool look_off_field) {
   blobs->clear();
   off_field_ball->clear();
-  known_ = &known;
   const int width = image.width;
   // The look off the field moves within the grid's cells from cycle to cycle.
   const int du = static_cast<int>(phase % stride_), dv = static_cast<int>((phase / stride_) % stride_);
@@ -169,7 +168,7 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
     if (!ExpectedClassModel::mayBeOffField(p.range_m, safe[p.sector])) {
       uint8_t c[3];
       image.color(static_cast<int>(p.pixel % width), static_cast<int>(p.pixel / width), c);
-      const uint8_t k = classOf(lut, c);
+      const uint8_t k = classOf(lut, known, c);
       g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
       if (g == kGridBall) ball_points_.push_back(p.cell);
     } else if (look_off_field) {
@@ -185,10 +184,7 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
     }
   }
   // Connected components of ball grid points (8-neighbourhood), the largest first.
-  struct Component {
-    size_t begin, end;
-  };
-  std::vector<Component> components;
+  components_.clear();
   component_.clear();
   const size_t max_points = static_cast<size_t>(kMaxAreaFactor * max_area_px_ / (stride_ * stride_)) + 4;
   for (const uint32_t start : ball_points_) {
@@ -216,28 +212,28 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
       component_.resize(begin);  // far larger than a ball: an untrained region
       continue;
     }
-    components.push_back({begin, component_.size()});
+    components_.push_back({begin, component_.size()});
   }
-  std::sort(components.begin(), components.end(),
+  std::sort(components_.begin(), components_.end(),
             [](const Component& a, const Component& b) { return a.end - a.begin > b.end - b.begin; });
-  if (components.size() > kMaxBlobs) components.resize(kMaxBlobs);
-  std::vector<uint32_t> seeds;
-  for (const Component& c : components) {
-    seeds.clear();
+  if (components_.size() > kMaxBlobs) components_.resize(kMaxBlobs);
+  for (const Component& c : components_) {
+    seeds_.clear();
     for (size_t j = c.begin; j < c.end; ++j) {
       const uint32_t cell = component_[j];
       const int u = std::min(static_cast<int>(cell % grid_w_) * stride_ + stride_ / 2, width - 1);
       const int v = std::min(static_cast<int>(cell / grid_w_) * stride_ + stride_ / 2, image.height - 1);
-      seeds.push_back(static_cast<uint32_t>(v * width + u));
+      seeds_.push_back(static_cast<uint32_t>(v * width + u));
     }
     BallBlob blob;
-    measure(model, image, lut, safe, seeds, &blob);
+    measure(model, image, lut, safe, known, &blob);
     if (blob.pixels > 0) blobs->push_back(std::move(blob));
   }
 }
 
 void BallDetector::measure(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,
-                           const SafeRanges& safe, const std::vector<uint32_t>& seeds, BallBlob* blob) {
+                           const SafeRanges& safe, const std::vector<KnownColor>& known, BallBlob* blob) {
+  const std::vector<uint32_t>& seeds = seeds_;
   const int width = image.width, height = image.height;
   const CameraCalibration& cal = model.camera().calibration();
   const BallGeometry geometry(model.camera(), radius_m_);
@@ -282,24 +278,24 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
   const double grow_radius = std::max(kGrowMinRadius, kGrowSpreads * seed_spread);
   // window_: -1 not looked at, 0 looked at and not in the blob, 1 in the blob.
   auto look = [&](uint32_t pixel) {
-    int32_t& mark = window_[pixel];
+    int8_t& mark = window_[pixel];
     if (mark >= 0) return false;
     mark = 0;
     if (!onCarpet(model, sectors_, pixel, safe, reach_)) return false;
     uint8_t c[3];
     image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
-    const uint8_t k = classOf(lut, c);
+    const uint8_t k = classOf(lut, known, c);
     if (!ballCandidate(k)) return false;
     if ((Eigen::Vector3d(c[0], c[1], c[2]) - seed_mean).norm() > grow_radius) return false;
     mark = 1;
-    if (k == kOrange) ++blob->ball_cells;
+    if (k == kOrange) ++blob->ball_pixels;
     return true;
   };
-  std::vector<uint32_t> looked;
+  looked_.clear();
   pixel_stack_.clear();
   for (const uint32_t s : seeds) {
     if (look(s)) pixel_stack_.push_back(s);
-    looked.push_back(s);
+    looked_.push_back(s);
   }
   while (!pixel_stack_.empty()) {
     const uint32_t p = pixel_stack_.back();
@@ -312,13 +308,13 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
       if (x < u0 || x > u1 || y < v0 || y > v1) continue;
       const uint32_t q = static_cast<uint32_t>(y * width + x);
       if (window_[q] >= 0) continue;
-      looked.push_back(q);
+      looked_.push_back(q);
       if (look(q)) pixel_stack_.push_back(q);
     }
   }
   blob->pixels = static_cast<uint32_t>(blob->members.size());
   if (blob->pixels == 0) {
-    for (const uint32_t q : looked) window_[q] = -1;
+    for (const uint32_t q : looked_) window_[q] = -1;
     return;
   }
   // Shape in polar coordinates about the mirror's axis.
@@ -360,9 +356,11 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
   }
   // Interior pixels, and the colors.
   blob->interior.assign(blob->members.size(), 0);
-  std::array<std::vector<uint8_t>, 3> channels;
+  std::array<std::vector<uint8_t>, 3>& channels = channels_;
+  for (auto& values : channels) values.clear();
   Eigen::Vector3d sum(0, 0, 0);
-  std::vector<Eigen::Vector3d> colors;
+  std::vector<Eigen::Vector3d>& colors = colors_;
+  colors.clear();
   for (size_t j = 0; j < blob->members.size(); ++j) {
     const uint32_t p = blob->members[j];
     const int u = static_cast<int>(p % width), v = static_cast<int>(p / width);
@@ -409,12 +407,12 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
       ++around;
       uint8_t c[3];
       image.color(u, v, c);
-      const uint8_t k = classOf(lut, c);
+      const uint8_t k = classOf(lut, known, c);
       carpet += k == kGreen || k == kWhite;
     }
   }
   blob->surround = around ? static_cast<double>(carpet) / around : 0.0;
-  for (const uint32_t q : looked) window_[q] = -1;
+  for (const uint32_t q : looked_) window_[q] = -1;
 }
 
 }  // namespace core

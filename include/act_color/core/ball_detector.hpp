@@ -42,8 +42,8 @@ class BallGeometry {
 // A connected blob of pixels on the carpet whose table class is unknown or the ball's, measured
 // as a ball would be.
 struct BallBlob {
-  uint32_t pixels = 0;      // in the blob
-  uint32_t ball_cells = 0;  // of them classified as the ball
+  uint32_t pixels = 0;       // in the blob
+  uint32_t ball_pixels = 0;  // of them classified as the ball
   double centroid_u = 0, centroid_v = 0;
   double r_near_px = 0, r_far_px = 0;  // image radii of the nearest and farthest pixel
   double distance_m = 0;               // ground distance of the ball's centre (BallGeometry)
@@ -93,12 +93,12 @@ class BallDetector {
 
  private:
   using SafeRanges = std::array<double, ExpectedClassModel::kRemovalSectors>;
+  // Grows and measures the blob of seeds_.
   void measure(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut, const SafeRanges& safe,
-               const std::vector<uint32_t>& seeds, BallBlob* blob);
+               const std::vector<KnownColor>& known, BallBlob* blob);
   // The pixel's class for the blobs: the table's, or for unknown colors that a known class's
   // cluster includes, that class.
-  uint8_t classOf(const ColorLut& lut, const uint8_t c[3]) const;
-  const std::vector<KnownColor>* known_ = nullptr;
+  static uint8_t classOf(const ColorLut& lut, const std::vector<KnownColor>& known, const uint8_t c[3]);
 
   double radius_m_;
   int stride_ = 3;
@@ -119,8 +119,16 @@ class BallDetector {
   std::vector<uint32_t> ball_points_;  // this cycle's grid cells of unknown or ball colors
   std::vector<uint32_t> stack_;
   std::vector<uint32_t> component_;
-  std::vector<int32_t> window_;  // full-resolution marks of the blob being grown
+  struct Component {
+    size_t begin, end;  // in component_
+  };
+  std::vector<Component> components_;
+  std::vector<uint32_t> seeds_;   // the pixels of one component's grid points
+  std::vector<int8_t> window_;    // full-resolution marks of the blob being grown (measure)
+  std::vector<uint32_t> looked_;  // the pixels marked in window_, to unmark
   std::vector<uint32_t> pixel_stack_;
+  std::array<std::vector<uint8_t>, 3> channels_;  // a blob's colors by channel, for the medians
+  std::vector<Eigen::Vector3d> colors_;
 };
 
 }  // namespace core
