@@ -261,6 +261,26 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   space_known_ = true;
 }
 
+void ActTrainer::restore(const ColorLut& lut, const std::vector<SavedCluster>& clusters, uint64_t revision) {
+  for (const SavedCluster& c : clusters) {
+    const bool finite = c.mean.allFinite() && std::isfinite(c.sigma);
+    if (c.class_id < 1 || c.class_id >= kNumClasses || !finite || !(c.sigma > 0.0) || c.mean.minCoeff() < 0.0 ||
+        c.mean.maxCoeff() > 255.0) {
+      std::ostringstream s;
+      s << "cluster of class " << c.class_id << " (mean " << c.mean.transpose() << ", sigma " << c.sigma
+        << ") is not a cluster of a class 1-" << kNumClasses - 1;
+      throw std::invalid_argument(s.str());
+    }
+  }
+  loadTable(lut);
+  for (ClassCluster& cluster : clusters_) cluster.reset(255.0);
+  const auto counts = lut_.cellCounts();
+  for (const SavedCluster& c : clusters) {
+    if (counts[c.class_id] > 0) clusters_[c.class_id].set(c.mean, c.sigma, true);
+  }
+  revision_ = revision;
+}
+
 ClusterParams ActTrainer::clusterParams() const {
   ClusterParams p;
   p.eta = params_.eta;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -145,6 +146,33 @@ std::vector<Feature> extractFeatures(const cv::Mat& labels, const OmniCameraMode
                                    static_cast<uint32_t>(stats.at<int>(c, cv::CC_STAT_AREA))));
   }
   return features;
+}
+
+void FeatureParams::validate() const {
+  auto require = [](const char* name, double value, double lo, double hi) {
+    if (!(value >= lo && value <= hi)) {
+      std::ostringstream s;
+      s << "parameter " << name << " must be in [" << lo << ", " << hi << "], is " << value;
+      throw std::invalid_argument(s.str());
+    }
+  };
+  require("scan_lines", scan_lines, 4, 3600);
+  require("max_line_run_px", max_line_run_px, 1, 1000);
+  require("min_goal_run_px", min_goal_run_px, 1, 1000);
+  require("min_obstacle_run_px", min_obstacle_run_px, 1, 1000);
+  require("min_ball_pixels", min_ball_pixels, 1, 100000);
+  require("obstacle_merge_m", obstacle_merge_m, 0.0, 10.0);
+}
+
+void removeOffField(const FieldCalibration& field, std::vector<Feature>* features) {
+  const double beyond_x = std::max(field.margin_m, field.goal_setback_m + field.goal_depth_m);
+  const double half_x = 0.5 * field.length_m + beyond_x;
+  const double half_y = 0.5 * field.width_m + field.margin_m;
+  features->erase(std::remove_if(features->begin(), features->end(),
+                                 [&](const Feature& f) {
+                                   return !(std::abs(f.field_x_m) <= half_x && std::abs(f.field_y_m) <= half_y);
+                                 }),
+                  features->end());
 }
 
 void toField(const Pose2D& pose, std::vector<Feature>* features) {

@@ -14,6 +14,7 @@
 
 #include "act_color/core/metrics.hpp"
 #include "act_color/core/types.hpp"
+#include "act_color/ros/nodelet_setup.hpp"
 
 namespace act_color {
 
@@ -46,7 +47,7 @@ void AccuracyMonitorNodelet::onInit() {
     try {
       report();
     } catch (const std::exception& e) {
-      NODELET_ERROR_THROTTLE(10.0, "%s", e.what());
+      ACT_WALL_THROTTLE(10.0, NODELET_ERROR("%s", e.what()));
     }
   });
 }
@@ -78,8 +79,8 @@ void AccuracyMonitorNodelet::match() {
         ++frames_window_;
         ++frames_total_;
       } else {
-        NODELET_ERROR_THROTTLE(10.0, "labels and truth of stamp %.3f do not fit (mono8, same size expected)",
-                               a.header.stamp.toSec());
+        ACT_WALL_THROTTLE(10.0, NODELET_ERROR("labels and truth of stamp %.3f do not fit (mono8, same size expected)",
+                                              a.header.stamp.toSec()));
       }
       truth_.erase(t);
       matched = true;

@@ -3,8 +3,8 @@
 // classified with it.
 #include <cv_bridge/cv_bridge.h>
 #include <diagnostic_updater/diagnostic_updater.h>
-#include <dynamic_reconfigure/server.h>
 #include <geometry_msgs/PointStamped.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
@@ -15,6 +15,8 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <pluginlib/class_list_macros.hpp>
 #include <sstream>
@@ -26,6 +28,7 @@
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/segmenter.hpp"
+#include "act_color/ros/checked_reconfigure.hpp"
 #include "act_color/ros/conversions.hpp"
 #include "act_color/ros/lut_file.hpp"
 #include "act_color/ros/nodelet_setup.hpp"
@@ -35,39 +38,59 @@ namespace act_color {
 
 class ActTrainerNodelet : public nodelet::Nodelet {
  public:
-  ~ActTrainerNodelet() override = default;
+  ~ActTrainerNodelet() override;
 
  private:
+  // What became of an image (diagnostics).
+  enum class Outcome { kTrained, kStartup, kNoPose, kRejected };
+  struct Pending {
+    sensor_msgs::ImageConstPtr image;
+    ros::WallTime arrival;
+  };
+  struct Record {
+    ros::WallTime at;
+    Outcome outcome;
+    double cycle_ms;    // the ACT cycle (or the start-up training), 0 when not trained
+    double latency_ms;  // image stamp to its table's publication (ROS time), -1 when none
+  };
+
   void onInit() override;
   bool configure(std::string* error);
+  bool readParams(core::ActParams* params, std::string* error);
   void onImage(const sensor_msgs::ImageConstPtr& msg);
-  void processImage(const sensor_msgs::ImageConstPtr& msg);
-  void trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_hold);
-  void publishClassified(const core::ImageView& view, const std_msgs::Header& header);
-  void onReconfigure(ActTrainerConfig& config, uint32_t level);
+  // Trains the waiting images in order, as far as their poses have come (or waited ~tf_timeout).
+  void drain();
+  // False: the image waits for its pose (may_wait and the pose may still come).
+  bool trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_wait);
+  void publishOutputs(const core::ImageView& view, const sensor_msgs::ImageConstPtr& msg, bool have_pose,
+                      const core::Pose2D& pose);
+  void onTimeJump(const ros::Time& from, const ros::Time& to);
+  void record(Outcome outcome, double cycle_ms, double latency_ms);
+  bool applyConfig(const ActTrainerConfig& config, std::string* error);
+  ActTrainerConfig configInEffect() const;
   // The file of a ~save_lut / ~load_lut request: its path or ~lut_file; false (and res filled)
   // when neither is set.
   bool requestPath(const FilePath::Request& req, FilePath::Response& res, std::string* path) const;
   bool onSaveLut(FilePath::Request& req, FilePath::Response& res);
   bool onLoadLut(FilePath::Request& req, FilePath::Response& res);
+  bool saveLut(const std::string& path, std::string* message);
   bool loadLut(const std::string& path, std::string* message);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::Subscriber image_sub_;
-  image_transport::Publisher classified_pub_;
-  ros::Publisher lut_pub_, debug_pub_, ball_pub_;
-  std::string base_frame_;
+  image_transport::Publisher classified_pub_, expected_pub_;
+  ros::Publisher lut_pub_, lut_throttled_pub_, debug_pub_, ball_pub_, pose_pub_;
+  std::string base_frame_, field_frame_;
   ros::ServiceServer save_srv_, load_srv_;
-  std::unique_ptr<dynamic_reconfigure::Server<ActTrainerConfig>> reconfigure_server_;
-  boost::recursive_mutex reconfigure_mutex_;
+  std::unique_ptr<ros_conversions::CheckedReconfigure<ActTrainerConfig>> reconfigure_;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
-  ros::Timer diagnostics_timer_;
+  ros::WallTimer diagnostics_timer_, drain_timer_;
   ros_conversions::PoseSource pose_source_;
 
   // Everything below is guarded by mutex_.
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   std::string config_error_;  // non-empty: the nodelet could not be configured and does nothing
   std::unique_ptr<core::ActTrainer> trainer_;
   std::unique_ptr<core::Segmenter> segmenter_;
@@ -78,18 +101,52 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool bootstrap_at_first_pose_ = false;
   bool has_table_ = false;  // bootstrapped, loaded or trained at least once
   std::string lut_file_;
+  bool save_on_shutdown_ = false;
+  bool reset_on_time_jump_ = false;
   bool debug_addresses_ = false;
-  cv::Mat labels_, classified_;
-  // An image whose pose had not come yet (pose and image of one instant on two connections):
-  // trained when the next image comes, before it.
-  sensor_msgs::ImageConstPtr held_image_;
-  // Statistics for diagnostics.
-  uint64_t images_ = 0, cycles_ = 0, skipped_ = 0, rejected_ = 0;
-  double last_cycle_ms_ = 0.0, max_cycle_ms_ = 0.0, sum_cycle_ms_ = 0.0;
-  std::string last_skip_reason_;
-  std::deque<ros::WallTime> arrivals_;
+  double max_pose_age_s_ = 1.0;
+  double tf_timeout_s_ = 0.1;
+  int publish_lut_every_ = 1;
+  double lut_throttled_period_s_ = 1.0;
+  ros::WallTime last_throttled_;
+  uint64_t publishable_ = 0;  // images whose table could be published
+  cv::Mat labels_, classified_, expected_;
+  // Images waiting for their pose (pose and image of one instant come on two connections), in
+  // order; at most kMaxPending.
+  static constexpr size_t kMaxPending = 30;
+  std::deque<Pending> pending_;
+  ros_conversions::TimeJumpDetector image_time_;
+  // Statistics for diagnostics: totals since the start (or the last time jump) ...
+  uint64_t images_ = 0, cycles_ = 0, skipped_ = 0, rejected_ = 0, time_jumps_ = 0;
+  double startup_ms_ = 0.0;
+  std::string last_skip_reason_, last_reject_reason_;
   core::CycleStats last_stats_;
+  // ... and the last seconds.
+  static constexpr double kWindowS = 5.0;
+  static constexpr double kFillWindowS = 30.0;
+  std::deque<Record> window_;
+  std::deque<std::pair<ros::WallTime, uint64_t>> fill_history_;  // filled cells, once per diagnostics
+  ros::WallTime last_image_;
 };
+
+ActTrainerNodelet::~ActTrainerNodelet() {
+  // ~save_on_shutdown: the table of this run survives the robot's restart. Never throws.
+  try {
+    std::string path, message;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!save_on_shutdown_ || !has_table_ || !trainer_) return;
+      path = lut_file_;
+    }
+    if (saveLut(path, &message)) {
+      NODELET_INFO("at shutdown: %s", message.c_str());
+    } else {
+      NODELET_ERROR("at shutdown: ~save_on_shutdown: %s", message.c_str());
+    }
+  } catch (const std::exception& e) {
+    NODELET_ERROR("at shutdown: the table was not saved: %s", e.what());
+  }
+}
 
 void ActTrainerNodelet::onInit() {
   nh_ = getNodeHandle();
@@ -105,42 +162,54 @@ void ActTrainerNodelet::onInit() {
   }
 }
 
+bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) {
+  using ros_conversions::readParam;
+  core::ActParams& p = *params;
+  int seed = static_cast<int>(p.seed);
+  const bool read = readParam(pnh_, "eta", &p.eta, error) && readParam(pnh_, "zeta", &p.zeta, error) &&
+                    readParam(pnh_, "xi", &p.xi, error) && readParam(pnh_, "sigma_min", &p.sigma_min, error) &&
+                    readParam(pnh_, "cluster_stride", &p.cluster_stride, error) &&
+                    readParam(pnh_, "add_stride", &p.add_stride, error) &&
+                    readParam(pnh_, "remove_stride", &p.remove_stride, error) &&
+                    readParam(pnh_, "lut_bits", &p.lut_bits, error) &&
+                    readParam(pnh_, "white_filter", &p.white_filter, error) && readParam(pnh_, "seed", &seed, error) &&
+                    // Extensions beyond the paper (README, "The algorithm, and beyond the paper").
+                    readParam(pnh_, "add_neighbourhood_cells", &p.add_neighbourhood_cells, error) &&
+                    readParam(pnh_, "light_compensation", &p.light_compensation, error) &&
+                    readParam(pnh_, "light_change_add_stride", &p.light_change_add_stride, error) &&
+                    readParam(pnh_, "removal_protect_cycles", &p.removal_protect_cycles, error) &&
+                    readParam(pnh_, "robots_train_black", &p.robots_train_black, error) &&
+                    readParam(pnh_, "nearest_mean", &p.nearest_mean, error) &&
+                    readParam(pnh_, "evidence_removal_ratio", &p.evidence_removal_ratio, error) &&
+                    readParam(pnh_, "ball_training", &p.ball_training, error) &&
+                    readParam(pnh_, "ball_diameter_m", &p.ball_diameter_m, error);
+  if (!read) return false;
+  if (seed < 0) {
+    *error = "parameter ~seed must be >= 0, is " + std::to_string(seed);
+    return false;
+  }
+  p.seed = static_cast<uint32_t>(seed);
+  try {
+    p.validate();
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+  return true;
+}
+
 bool ActTrainerNodelet::configure(std::string* error) {
+  using ros_conversions::readParam;
   core::Calibration calibration;
   std::string calibration_path;
   if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, error)) return false;
 
   core::ActParams params;
-  params.eta = pnh_.param("eta", params.eta);
-  params.zeta = pnh_.param("zeta", params.zeta);
-  params.xi = pnh_.param("xi", params.xi);
-  params.sigma_min = pnh_.param("sigma_min", params.sigma_min);
-  params.cluster_stride = pnh_.param("cluster_stride", params.cluster_stride);
-  params.add_stride = pnh_.param("add_stride", params.add_stride);
-  params.remove_stride = pnh_.param("remove_stride", params.remove_stride);
-  params.lut_bits = pnh_.param("lut_bits", params.lut_bits);
-  params.white_filter = pnh_.param("white_filter", params.white_filter);
-  params.seed = static_cast<uint32_t>(pnh_.param("seed", static_cast<int>(params.seed)));
-  // Extensions beyond the paper (README, "The algorithm, and beyond the paper").
-  params.add_neighbourhood_cells = pnh_.param("add_neighbourhood_cells", params.add_neighbourhood_cells);
-  params.light_compensation = pnh_.param("light_compensation", params.light_compensation);
-  params.light_change_add_stride = pnh_.param("light_change_add_stride", params.light_change_add_stride);
-  params.removal_protect_cycles = pnh_.param("removal_protect_cycles", params.removal_protect_cycles);
-  params.robots_train_black = pnh_.param("robots_train_black", params.robots_train_black);
-  params.nearest_mean = pnh_.param("nearest_mean", params.nearest_mean);
-  params.evidence_removal_ratio = pnh_.param("evidence_removal_ratio", params.evidence_removal_ratio);
-  params.ball_training = pnh_.param("ball_training", params.ball_training);
-  params.ball_diameter_m = pnh_.param("ball_diameter_m", params.ball_diameter_m);
+  if (!readParams(&params, error)) return false;
   // Extensions removed because the randomized scene family showed they did not help (issue 11):
   // a launch file that still sets them is told once instead of being ignored silently.
   for (const char* removed : {"seed_clusters", "robust_clusters"}) {
     if (pnh_.hasParam(removed)) NODELET_WARN("~%s is no longer a parameter (removed in issue 11); ignored", removed);
-  }
-  try {
-    params.validate();
-  } catch (const std::exception& e) {
-    *error = e.what();
-    return false;
   }
 
   std::vector<double> initial_pose;
@@ -152,14 +221,36 @@ bool ActTrainerNodelet::configure(std::string* error) {
     }
     initial_pose_ = p;
   }
-  bootstrap_cycles_ = pnh_.param("bootstrap_cycles", core::kDefaultBootstrapCycles);
-  bootstrap_at_first_pose_ = pnh_.param("bootstrap_at_first_pose", false);
-  if (bootstrap_cycles_ < 1 || bootstrap_cycles_ > 1000) {
-    *error = "~bootstrap_cycles must be in [1, 1000], is " + std::to_string(bootstrap_cycles_);
+  int bootstrap_cycles = core::kDefaultBootstrapCycles;
+  bool bootstrap_at_first_pose = false, save_on_shutdown = false, reset_on_time_jump = false, debug = false;
+  double tf_timeout = tf_timeout_s_, throttled_period = lut_throttled_period_s_, max_pose_age = max_pose_age_s_;
+  int publish_every = publish_lut_every_;
+  std::string lut_file, load_path, base_frame = "base_link", field_frame = "field";
+  if (!readParam(pnh_, "bootstrap_cycles", &bootstrap_cycles, error) ||
+      !readParam(pnh_, "bootstrap_at_first_pose", &bootstrap_at_first_pose, error) ||
+      !readParam(pnh_, "lut_file", &lut_file, error) || !readParam(pnh_, "load_lut", &load_path, error) ||
+      !readParam(pnh_, "save_on_shutdown", &save_on_shutdown, error) ||
+      !readParam(pnh_, "reset_on_time_jump", &reset_on_time_jump, error) ||
+      !readParam(pnh_, "tf_timeout", &tf_timeout, error) || !readParam(pnh_, "max_pose_age", &max_pose_age, error) ||
+      !readParam(pnh_, "publish_lut_every", &publish_every, error) ||
+      !readParam(pnh_, "lut_throttled_period", &throttled_period, error) ||
+      !readParam(pnh_, "debug_lut_addresses", &debug, error) || !readParam(pnh_, "base_frame", &base_frame, error) ||
+      !readParam(pnh_, "field_frame", &field_frame, error)) {
     return false;
   }
-  lut_file_ = pnh_.param<std::string>("lut_file", "");
-  debug_addresses_ = pnh_.param("debug_lut_addresses", false);
+  ActTrainerConfig node_config;
+  node_config.tf_timeout = tf_timeout;
+  node_config.max_pose_age = max_pose_age;
+  node_config.publish_lut_every = publish_every;
+  node_config.lut_throttled_period = throttled_period;
+  if (bootstrap_cycles < 1 || bootstrap_cycles > 1000) {
+    *error = "parameter ~bootstrap_cycles must be in [1, 1000], is " + std::to_string(bootstrap_cycles);
+    return false;
+  }
+  if (save_on_shutdown && lut_file.empty()) {
+    *error = "~save_on_shutdown needs ~lut_file (the file to save to)";
+    return false;
+  }
   if (!pose_source_.init(nh_, pnh_, getName(), error)) return false;
 
   {
@@ -167,8 +258,24 @@ bool ActTrainerNodelet::configure(std::string* error) {
     trainer_ = std::make_unique<core::ActTrainer>(calibration, params);
     segmenter_ = std::make_unique<core::Segmenter>(calibration.camera);
     params_ = params;
+    bootstrap_cycles_ = bootstrap_cycles;
+    bootstrap_at_first_pose_ = bootstrap_at_first_pose;
+    lut_file_ = lut_file;
+    save_on_shutdown_ = save_on_shutdown;
+    reset_on_time_jump_ = reset_on_time_jump;
+    debug_addresses_ = debug;
+    base_frame_ = base_frame;
+    field_frame_ = field_frame;
   }
-  const std::string load_path = pnh_.param<std::string>("load_lut", "");
+  // The node's own run-time parameters, checked as dynamic_reconfigure would check them.
+  {
+    ActTrainerConfig c = configInEffect();
+    c.tf_timeout = node_config.tf_timeout;
+    c.max_pose_age = node_config.max_pose_age;
+    c.publish_lut_every = node_config.publish_lut_every;
+    c.lut_throttled_period = node_config.lut_throttled_period;
+    if (!applyConfig(c, error)) return false;
+  }
   if (!load_path.empty()) {
     std::string message;
     if (loadLut(load_path, &message)) {
@@ -181,19 +288,36 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // The table is published as an immutable shared message: in the same manager, subscribers get
   // this very object (zero copy).
   lut_pub_ = nh_.advertise<act_color::ColorLut>("color_lut", 2);
+  // The same tables, at most one per ~lut_throttled_period: for rviz, rosbag record and anything
+  // off-process, which would otherwise carry the whole table with every image.
+  lut_throttled_pub_ = nh_.advertise<act_color::ColorLut>("color_lut_throttled", 1, true);
   // The ball on the carpet (ActParams::ball_training), in base_link, only when seen.
   ball_pub_ = nh_.advertise<geometry_msgs::PointStamped>("ball", 5);
-  base_frame_ = pnh_.param<std::string>("base_frame", "base_link");
+  // The pose each frame was trained with, for rviz's 3-D view (field frame).
+  pose_pub_ = pnh_.advertise<geometry_msgs::PoseStamped>("pose", 2);
   if (debug_addresses_) debug_pub_ = pnh_.advertise<std_msgs::UInt64MultiArray>("published_lut", 100);
   it_ = std::make_unique<image_transport::ImageTransport>(nh_);
   // Classified only while someone listens (checked per image); training needs every image anyway.
   classified_pub_ = it_->advertise("classified", 1);
+  // The camera image with the classes the field model expects at the pose (what ACT trains with).
+  expected_pub_ = it_->advertise("expected", 1);
   save_srv_ = pnh_.advertiseService("save_lut", &ActTrainerNodelet::onSaveLut, this);
   load_srv_ = pnh_.advertiseService("load_lut", &ActTrainerNodelet::onLoadLut, this);
-
-  // Reads eta .. remove_stride from the parameter server and calls onReconfigure once.
-  reconfigure_server_ = std::make_unique<dynamic_reconfigure::Server<ActTrainerConfig>>(reconfigure_mutex_, pnh_);
-  reconfigure_server_->setCallback([this](ActTrainerConfig& config, uint32_t level) { onReconfigure(config, level); });
+  reconfigure_ = std::make_unique<ros_conversions::CheckedReconfigure<ActTrainerConfig>>(
+      pnh_, configInEffect(), [this](const ActTrainerConfig& c, std::string* e) { return applyConfig(c, e); },
+      [this](const std::string& e) {
+        ACT_WALL_THROTTLE(0.2,
+                          NODELET_ERROR("dynamic_reconfigure: %s; not applied, the previous values stay", e.c_str()));
+      });
+  // Images whose pose had not come yet are tried again as tf or the pose arrives.
+  drain_timer_ = nh_.createWallTimer(ros::WallDuration(0.01), [this](const ros::WallTimerEvent&) {
+    try {
+      std::lock_guard<std::mutex> lock(mutex_);
+      drain();
+    } catch (const std::exception& e) {
+      ACT_WALL_THROTTLE(5.0, NODELET_ERROR("%s", e.what()));
+    }
+  });
 
   // Training needs every image, whether or not anyone listens to the outputs.
   const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
@@ -208,65 +332,190 @@ bool ActTrainerNodelet::configure(std::string* error) {
   return true;
 }
 
+ActTrainerConfig ActTrainerNodelet::configInEffect() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ActTrainerConfig c = ActTrainerConfig::__getDefault__();
+  const core::ActParams& p = params_;
+  c.eta = p.eta;
+  c.zeta = p.zeta;
+  c.xi = p.xi;
+  c.sigma_min = p.sigma_min;
+  c.cluster_stride = p.cluster_stride;
+  c.add_stride = p.add_stride;
+  c.remove_stride = p.remove_stride;
+  c.white_filter = p.white_filter;
+  c.add_neighbourhood_cells = p.add_neighbourhood_cells;
+  c.light_compensation = p.light_compensation;
+  c.light_change_add_stride = p.light_change_add_stride;
+  c.removal_protect_cycles = p.removal_protect_cycles;
+  c.robots_train_black = p.robots_train_black;
+  c.nearest_mean = p.nearest_mean;
+  c.evidence_removal_ratio = p.evidence_removal_ratio;
+  c.ball_training = p.ball_training;
+  c.ball_diameter_m = p.ball_diameter_m;
+  c.max_pose_age = max_pose_age_s_;
+  c.tf_timeout = tf_timeout_s_;
+  c.publish_lut_every = publish_lut_every_;
+  c.lut_throttled_period = lut_throttled_period_s_;
+  return c;
+}
+
+bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* error) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  core::ActParams p = params_;
+  p.eta = c.eta;
+  p.zeta = c.zeta;
+  p.xi = c.xi;
+  p.sigma_min = c.sigma_min;
+  p.cluster_stride = c.cluster_stride;
+  p.add_stride = c.add_stride;
+  p.remove_stride = c.remove_stride;
+  p.white_filter = c.white_filter;
+  p.add_neighbourhood_cells = c.add_neighbourhood_cells;
+  p.light_compensation = c.light_compensation;
+  p.light_change_add_stride = c.light_change_add_stride;
+  p.removal_protect_cycles = c.removal_protect_cycles;
+  p.robots_train_black = c.robots_train_black;
+  p.nearest_mean = c.nearest_mean;
+  p.evidence_removal_ratio = c.evidence_removal_ratio;
+  p.ball_training = c.ball_training;
+  p.ball_diameter_m = c.ball_diameter_m;
+  try {
+    p.validate();
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+  auto outside = [&](const char* name, double value, double lo, double hi, bool lo_open) {
+    if ((lo_open ? value > lo : value >= lo) && value <= hi) return false;
+    std::ostringstream s;
+    s << "parameter " << name << " must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], is " << value;
+    *error = s.str();
+    return true;
+  };
+  if (outside("max_pose_age", c.max_pose_age, 0.0, 60.0, true) ||
+      outside("tf_timeout", c.tf_timeout, 0.0, 5.0, false) ||
+      outside("publish_lut_every", c.publish_lut_every, 1, 1000, false) ||
+      outside("lut_throttled_period", c.lut_throttled_period, 0.0, 3600.0, false)) {
+    return false;
+  }
+  if (p.lut_bits != params_.lut_bits || p.seed != params_.seed) params_changed_ = true;
+  params_changed_ =
+      params_changed_ ||
+      !(p.eta == params_.eta && p.zeta == params_.zeta && p.xi == params_.xi && p.sigma_min == params_.sigma_min &&
+        p.cluster_stride == params_.cluster_stride && p.add_stride == params_.add_stride &&
+        p.remove_stride == params_.remove_stride && p.white_filter == params_.white_filter &&
+        p.add_neighbourhood_cells == params_.add_neighbourhood_cells &&
+        p.light_compensation == params_.light_compensation &&
+        p.light_change_add_stride == params_.light_change_add_stride &&
+        p.removal_protect_cycles == params_.removal_protect_cycles &&
+        p.robots_train_black == params_.robots_train_black && p.nearest_mean == params_.nearest_mean &&
+        p.evidence_removal_ratio == params_.evidence_removal_ratio && p.ball_training == params_.ball_training &&
+        p.ball_diameter_m == params_.ball_diameter_m);
+  params_ = p;  // applied by the next image, in the image callback
+  max_pose_age_s_ = c.max_pose_age;
+  pose_source_.setMaxAge(c.max_pose_age);
+  tf_timeout_s_ = c.tf_timeout;
+  publish_lut_every_ = c.publish_lut_every;
+  lut_throttled_period_s_ = c.lut_throttled_period;
+  return true;
+}
+
 void ActTrainerNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
   try {
-    processImage(msg);
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!trainer_) return;
+    const ros::Time before = image_time_.latest();
+    if (image_time_.jumpedBack(msg->header.stamp)) onTimeJump(before, msg->header.stamp);
+    ++images_;
+    last_image_ = ros::WallTime::now();
+    pending_.push_back({msg, last_image_});
+    drain();
   } catch (const std::exception& e) {
-    NODELET_ERROR_THROTTLE(5.0, "image stamped %.3f: %s", msg->header.stamp.toSec(), e.what());
+    ACT_WALL_THROTTLE(5.0, NODELET_ERROR("image stamped %.3f: %s", msg->header.stamp.toSec(), e.what()));
   }
 }
 
-void ActTrainerNodelet::processImage(const sensor_msgs::ImageConstPtr& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!trainer_) return;
-  ++images_;
-  arrivals_.push_back(ros::WallTime::now());
-  while (arrivals_.size() > 2 && (arrivals_.back() - arrivals_.front()).toSec() > 5.0) arrivals_.pop_front();
-  if (held_image_) {
-    const sensor_msgs::ImageConstPtr held = held_image_;
-    held_image_.reset();
-    trainOn(held, false);
+void ActTrainerNodelet::drain() {
+  while (!pending_.empty()) {
+    const Pending& front = pending_.front();
+    const bool may_wait =
+        pending_.size() <= kMaxPending && (ros::WallTime::now() - front.arrival).toSec() < tf_timeout_s_;
+    if (!trainOn(front.image, may_wait)) return;  // its pose may still come: later images wait behind it
+    pending_.pop_front();
   }
-  trainOn(msg, pose_source_.mode() == ros_conversions::PoseSource::Mode::kTopic);
 }
 
-void ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_hold) {
+void ActTrainerNodelet::onTimeJump(const ros::Time& from, const ros::Time& to) {
+  ++time_jumps_;
+  NODELET_WARN(
+      "time jumped back from %.3f to %.3f (a new replay?): poses, waiting images and statistics start "
+      "afresh; the color table is %s",
+      from.toSec(), to.toSec(), reset_on_time_jump_ ? "reset (~reset_on_time_jump)" : "kept");
+  pose_source_.forgetNewerThan(to + ros::Duration(ros_conversions::TimeJumpDetector::kJumpBackS));
+  pending_.clear();
+  window_.clear();
+  fill_history_.clear();
+  images_ = cycles_ = skipped_ = rejected_ = 0;
+  last_skip_reason_.clear();
+  last_reject_reason_.clear();
+  if (reset_on_time_jump_) {
+    trainer_->reset(trainer_->lut().colorSpace());
+    has_table_ = false;  // trained again from the start (~initial_pose, the first pose or online)
+  }
+}
+
+void ActTrainerNodelet::record(Outcome outcome, double cycle_ms, double latency_ms) {
+  const ros::WallTime now = ros::WallTime::now();
+  window_.push_back({now, outcome, cycle_ms, latency_ms});
+  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+}
+
+bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_wait) {
   core::ImageView view;
   std::string error;
   // A view of the shared message: no copy of the image.
+  // Two throttled messages: one kind of bad image does not hide the other.
   if (!ros_conversions::imageView(*msg, &view, &error)) {
-    ++rejected_;
-    NODELET_ERROR_THROTTLE(5.0, "image rejected: %s", error.c_str());
-    return;
+    ACT_WALL_THROTTLE(5.0, NODELET_ERROR("image rejected: %s", error.c_str()));
+  } else {
+    try {
+      trainer_->checkImage(view);
+    } catch (const std::invalid_argument& e) {
+      error = e.what();
+      ACT_WALL_THROTTLE(5.0, NODELET_ERROR("image rejected: %s", error.c_str()));
+    }
   }
-  try {
-    trainer_->checkImage(view);
-  } catch (const std::invalid_argument& e) {
+  if (!error.empty()) {
     ++rejected_;
-    NODELET_ERROR_THROTTLE(5.0, "image rejected: %s", e.what());
-    return;
+    last_reject_reason_ = error;
+    record(Outcome::kRejected, 0.0, -1.0);
+    return true;
   }
+
+  core::Pose2D pose;
+  std::string why;
+  const bool have_pose = pose_source_.lookup(msg->header.stamp, &pose, &why);
+  const bool startup = !has_table_ && (initial_pose_ || (bootstrap_at_first_pose_ && have_pose));
+  if (!have_pose && !startup && may_wait && pose_source_.mayStillCome(msg->header.stamp)) return false;
   if (params_changed_) {
     trainer_->setParams(params_);
     params_changed_ = false;
   }
 
   const auto start = std::chrono::steady_clock::now();
-  bool trained = false;
-  core::Pose2D pose;
-  std::string why;
-  const bool have_pose = pose_source_.lookup(msg->header.stamp, &pose, &why);
-  if (!has_table_ && (initial_pose_ || (bootstrap_at_first_pose_ && have_pose))) {
+  Outcome outcome = Outcome::kNoPose;
+  if (startup) {
     // The start-up table (paper, section 2): the first image at a known pose.
-    const core::Pose2D start = initial_pose_ ? *initial_pose_ : pose;
-    trainer_->bootstrap(view, start, bootstrap_cycles_);
+    const core::Pose2D at = initial_pose_ ? *initial_pose_ : pose;
+    trainer_->bootstrap(view, at, bootstrap_cycles_);
     NODELET_INFO("start-up table trained with %d cycles on the image stamped %.3f at the %s pose (%.2f, %.2f, %.2f)",
-                 bootstrap_cycles_, msg->header.stamp.toSec(), initial_pose_ ? "initial" : "first localization",
-                 start.x_m, start.y_m, start.theta_rad);
-    trained = true;
+                 bootstrap_cycles_, msg->header.stamp.toSec(), initial_pose_ ? "initial" : "first localization", at.x_m,
+                 at.y_m, at.theta_rad);
+    outcome = Outcome::kStartup;
   } else if (have_pose) {
     last_stats_ = trainer_->cycle(view, pose);
-    trained = true;
+    outcome = Outcome::kTrained;
     if (last_stats_.ball.seen) {
       geometry_msgs::PointStamped ball;
       ball.header.stamp = msg->header.stamp;
@@ -276,76 +525,112 @@ void ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
       ball.point.z = 0.0;  // where it rests on the carpet
       ball_pub_.publish(ball);
     }
-  } else if (may_hold) {
-    NODELET_WARN_THROTTLE(5.0, "image stamped %.3f: %s; waiting for the next image", msg->header.stamp.toSec(),
-                          why.c_str());
-    held_image_ = msg;
-    return;
   } else {
     ++skipped_;
     last_skip_reason_ = why;
-    NODELET_WARN_THROTTLE(5.0, "no training on the image stamped %.3f: %s", msg->header.stamp.toSec(), why.c_str());
+    ACT_WALL_THROTTLE(
+        5.0, NODELET_WARN("no training on the image stamped %.3f: %s", msg->header.stamp.toSec(), why.c_str()));
   }
-  if (trained) {
+  const double cycle_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (outcome == Outcome::kStartup) {
+    has_table_ = true;
+    startup_ms_ = cycle_ms;
+  } else if (outcome == Outcome::kTrained) {
     has_table_ = true;
     ++cycles_;
-    last_cycle_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    sum_cycle_ms_ += last_cycle_ms_;
-    max_cycle_ms_ = std::max(max_cycle_ms_, last_cycle_ms_);
   }
+  double latency_ms = -1.0;
   // One table per usable image, stamped with it: "the table trained on frames up to and
   // including t", also when this frame could not train (the segmentation then need not wait).
-  if (!has_table_ || trainer_->lut().colorSpace() != core::nativeColorSpace(view.format)) return;
-  boost::shared_ptr<const act_color::ColorLut> lut = ros_conversions::toMsg(*trainer_, msg->header);
-  lut_pub_.publish(lut);
-  if (debug_addresses_) {
-    std_msgs::UInt64MultiArray debug;
-    debug.data = {msg->header.stamp.toNSec(), reinterpret_cast<uint64_t>(lut.get()), lut->revision};
-    debug_pub_.publish(debug);
+  if (has_table_ && trainer_->lut().colorSpace() == core::nativeColorSpace(view.format)) {
+    publishOutputs(view, msg, have_pose || startup, initial_pose_ && !have_pose ? *initial_pose_ : pose);
+    latency_ms = (ros::Time::now() - msg->header.stamp).toSec() * 1000.0;
   }
-  if (classified_pub_.getNumSubscribers() > 0) publishClassified(view, msg->header);
+  record(outcome, outcome == Outcome::kNoPose ? 0.0 : cycle_ms, latency_ms);
+  return true;
 }
 
-void ActTrainerNodelet::publishClassified(const core::ImageView& view, const std_msgs::Header& header) {
-  segmenter_->classify(trainer_->lut(), view, labels_);
-  cv_bridge::CvImage out(header, "rgb8");
-  core::colorizeLabels(labels_, out.image);
-  classified_pub_.publish(out.toImageMsg());
+void ActTrainerNodelet::publishOutputs(const core::ImageView& view, const sensor_msgs::ImageConstPtr& msg,
+                                       bool have_pose, const core::Pose2D& pose) {
+  const std_msgs::Header& header = msg->header;
+  ++publishable_;
+  const bool every = (publishable_ - 1) % static_cast<uint64_t>(publish_lut_every_) == 0;
+  const ros::WallTime now = ros::WallTime::now();
+  const bool throttled = lut_throttled_period_s_ > 0.0 && lut_throttled_pub_.getNumSubscribers() > 0 &&
+                         (now - last_throttled_).toSec() >= lut_throttled_period_s_;
+  if (every || throttled) {
+    boost::shared_ptr<const act_color::ColorLut> lut = ros_conversions::toMsg(*trainer_, header);
+    if (every) lut_pub_.publish(lut);
+    if (throttled) {
+      lut_throttled_pub_.publish(lut);
+      last_throttled_ = now;
+    }
+    if (debug_addresses_ && every) {
+      std_msgs::UInt64MultiArray debug;
+      debug.data = {header.stamp.toNSec(), reinterpret_cast<uint64_t>(lut.get()), lut->revision};
+      debug_pub_.publish(debug);
+    }
+  }
+  if (classified_pub_.getNumSubscribers() > 0) {
+    segmenter_->classify(trainer_->lut(), view, labels_);
+    cv_bridge::CvImage out(header, "rgb8");
+    core::colorizeLabels(labels_, out.image);
+    classified_pub_.publish(out.toImageMsg());
+  }
+  if (!have_pose) return;
+  if (pose_pub_.getNumSubscribers() > 0) {
+    geometry_msgs::PoseStamped p;
+    p.header.stamp = header.stamp;
+    p.header.frame_id = field_frame_;
+    p.pose.position.x = pose.x_m;
+    p.pose.position.y = pose.y_m;
+    p.pose.orientation.z = std::sin(0.5 * pose.theta_rad);
+    p.pose.orientation.w = std::cos(0.5 * pose.theta_rad);
+    pose_pub_.publish(p);
+  }
+  if (expected_pub_.getNumSubscribers() > 0) {
+    // Half the camera image, half the expected class (eq. 1 applied: white that fails it is grey).
+    cv::Mat expected = trainer_->model().expectedLabels(view, pose);
+    expected.setTo(core::kUnknown, expected == core::kRejectedWhite);
+    core::colorizeLabels(expected, expected_);
+    const bool uyvy = view.format == core::PixelFormat::kUyvy;
+    const cv::Mat raw(view.height, view.width, uyvy ? CV_8UC2 : CV_8UC3, const_cast<uint8_t*>(view.data), view.step);
+    cv::Mat rgb = raw;
+    if (uyvy) cv::cvtColor(raw, rgb, cv::COLOR_YUV2RGB_UYVY);
+    if (view.format == core::PixelFormat::kBgr8) cv::cvtColor(raw, rgb, cv::COLOR_BGR2RGB);
+    cv_bridge::CvImage out(header, "rgb8");
+    cv::addWeighted(rgb, 0.5, expected_, 0.5, 0.0, out.image);
+    expected_pub_.publish(out.toImageMsg());
+  }
 }
 
-void ActTrainerNodelet::onReconfigure(ActTrainerConfig& config, uint32_t /*level*/) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  core::ActParams p = params_;
-  p.eta = config.eta;
-  p.zeta = config.zeta;
-  p.xi = config.xi;
-  p.sigma_min = config.sigma_min;
-  p.cluster_stride = config.cluster_stride;
-  p.add_stride = config.add_stride;
-  p.remove_stride = config.remove_stride;
-  try {
-    p.validate();
-  } catch (const std::exception& e) {
-    NODELET_ERROR_THROTTLE(1.0, "dynamic_reconfigure: %s; not applied, keeping the previous values", e.what());
-    // Show what is in effect.
-    config.eta = params_.eta;
-    config.zeta = params_.zeta;
-    config.xi = params_.xi;
-    config.sigma_min = params_.sigma_min;
-    config.cluster_stride = params_.cluster_stride;
-    config.add_stride = params_.add_stride;
-    config.remove_stride = params_.remove_stride;
-    return;
+bool ActTrainerNodelet::saveLut(const std::string& path, std::string* message) {
+  act_color::ColorLutPtr msg;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!trainer_ || !has_table_) {
+      *message = trainer_ ? "no table trained yet" : "the nodelet is not configured: " + config_error_;
+      return false;
+    }
+    std_msgs::Header header;
+    header.stamp = image_time_.latest();
+    msg = ros_conversions::toMsg(*trainer_, header);
   }
-  params_ = p;
-  params_changed_ = true;  // applied by the next image, in the image callback
+  std::string error;
+  if (!ros_conversions::saveLutFile(*msg, path, &error)) {
+    *message = error;
+    return false;
+  }
+  *message = "saved the color table (revision " + std::to_string(msg->revision) + ") and its clusters to " + path;
+  return true;
 }
 
 bool ActTrainerNodelet::loadLut(const std::string& path, std::string* message) {
   act_color::ColorLut msg;
   core::ColorLut lut;
+  std::vector<core::ActTrainer::SavedCluster> clusters;
   if (!ros_conversions::loadLutFile(path, &msg, message)) return false;
-  if (!ros_conversions::fromMsg(msg, &lut, message)) {
+  if (!ros_conversions::fromMsg(msg, &lut, &clusters, message)) {
     *message = path + ": " + *message;
     return false;
   }
@@ -355,17 +640,19 @@ bool ActTrainerNodelet::loadLut(const std::string& path, std::string* message) {
     return false;
   }
   try {
-    trainer_->loadTable(lut);
+    trainer_->restore(lut, clusters, msg.revision);
   } catch (const std::exception& e) {
     *message = path + ": " + e.what();
     return false;
   }
   has_table_ = true;
-  *message = "loaded the color table of " + path + " (revision " + std::to_string(msg.revision) + ")";
+  *message = "loaded the color table of " + path + " (revision " + std::to_string(msg.revision) + ", " +
+             std::to_string(clusters.size()) + " clusters)";
   return true;
 }
 
 bool ActTrainerNodelet::requestPath(const FilePath::Request& req, FilePath::Response& res, std::string* path) const {
+  std::lock_guard<std::mutex> lock(mutex_);
   *path = req.path.empty() ? lut_file_ : req.path;
   if (!path->empty()) return true;
   res.success = false;
@@ -376,23 +663,8 @@ bool ActTrainerNodelet::requestPath(const FilePath::Request& req, FilePath::Resp
 bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& res) {
   std::string path;
   if (!requestPath(req, res, &path)) return true;
-  act_color::ColorLutPtr msg;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!trainer_ || !has_table_) {
-      res.success = false;
-      res.message = trainer_ ? "no table trained yet" : "the nodelet is not configured: " + config_error_;
-      return true;
-    }
-    std_msgs::Header header;
-    header.stamp = ros::Time::now();
-    msg = ros_conversions::toMsg(*trainer_, header);
-  }
-  std::string error;
-  res.success = ros_conversions::saveLutFile(*msg, path, &error);
-  res.message =
-      res.success ? "saved the color table (revision " + std::to_string(msg->revision) + ") to " + path : error;
-  if (!res.success) NODELET_ERROR("~save_lut: %s", error.c_str());
+  res.success = saveLut(path, &res.message);
+  if (!res.success) NODELET_ERROR("~save_lut: %s", res.message.c_str());
   return true;
 }
 
@@ -405,41 +677,97 @@ bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& re
 }
 
 void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
   if (!config_error_.empty() || !trainer_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "not configured: " + config_error_);
+    status.summary(DiagnosticStatus::ERROR, "not configured: " + config_error_);
     return;
   }
-  double rate = 0.0;
-  if (arrivals_.size() >= 2) {
-    const double span = (arrivals_.back() - arrivals_.front()).toSec();
-    if (span > 0) rate = (arrivals_.size() - 1) / span;
-    if ((ros::WallTime::now() - arrivals_.back()).toSec() > 2.0) rate = 0.0;
+  const ros::WallTime now = ros::WallTime::now();
+  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+  size_t trained = 0, no_pose = 0, rejected = 0, cycles = 0, latencies = 0;
+  double sum_ms = 0, max_ms = 0, sum_latency = 0, max_latency = 0;
+  for (const Record& r : window_) {
+    if (r.outcome == Outcome::kRejected) ++rejected;
+    if (r.outcome == Outcome::kNoPose) ++no_pose;
+    if (r.outcome == Outcome::kTrained || r.outcome == Outcome::kStartup) ++trained;
+    if (r.outcome == Outcome::kTrained) {  // the start-up training is reported apart
+      ++cycles;
+      sum_ms += r.cycle_ms;
+      max_ms = std::max(max_ms, r.cycle_ms);
+    }
+    if (r.latency_ms >= 0) {
+      ++latencies;
+      sum_latency += r.latency_ms;
+      max_latency = std::max(max_latency, r.latency_ms);
+    }
   }
+  const size_t n = window_.size();
+  const double since_image = last_image_.isZero() ? -1.0 : (now - last_image_).toSec();
+  const auto counts = trainer_->lut().cellCounts();
+  uint64_t filled = 0;
+  for (int k = 1; k < core::kNumClasses; ++k) filled += counts[k];
+  fill_history_.emplace_back(now, filled);
+  while (!fill_history_.empty() && (now - fill_history_.front().first).toSec() > kFillWindowS) {
+    fill_history_.pop_front();
+  }
+  uint64_t max_filled = 0;
+  for (const auto& f : fill_history_) max_filled = std::max(max_filled, f.second);
+  auto percent = [](double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0.0; };
+  const double fill_percent = percent(filled, trainer_->lut().size());
+
+  status.summary(DiagnosticStatus::OK, "training");
+  std::ostringstream m;
+  m.precision(3);
   if (images_ == 0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no image received yet");
-  } else if (rate == 0.0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no image for more than 2 s");
-  } else if (!last_skip_reason_.empty() && skipped_ > 0 && cycles_ == 0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "not training: " + last_skip_reason_);
+    status.summary(DiagnosticStatus::WARN, "no image received yet");
+  } else if (since_image > 2.0) {
+    m << "no image for " << since_image << " s (input stale)";
+    status.summary(DiagnosticStatus::WARN, m.str());
+  } else if (n > 0 && rejected == n) {
+    status.summary(DiagnosticStatus::ERROR, "every image rejected: " + last_reject_reason_);
   } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "training");
+    if (rejected > 0) {
+      m << rejected << " of " << n << " images in " << kWindowS << " s rejected: " << last_reject_reason_;
+      status.mergeSummary(DiagnosticStatus::WARN, m.str());
+      m.str("");
+    }
+    if (n > rejected && trained == 0) {
+      status.mergeSummary(DiagnosticStatus::ERROR, "not training: " + last_skip_reason_);
+    } else if (no_pose > 0 && trained < 0.9 * (n - rejected)) {
+      m << "only " << percent(trained, n - rejected) << "% of the images trained: " << last_skip_reason_;
+      status.mergeSummary(DiagnosticStatus::WARN, m.str());
+      m.str("");
+    }
   }
-  status.add("input rate (Hz)", rate);
+  if (has_table_ && filled == 0) {
+    status.mergeSummary(DiagnosticStatus::ERROR, "the color table is empty");
+  } else if (max_filled > 0 && 2 * filled < max_filled) {
+    m << "the color table shrank from " << percent(max_filled, trainer_->lut().size()) << "% to " << fill_percent
+      << "% of its cells in " << kFillWindowS << " s";
+    status.mergeSummary(DiagnosticStatus::WARN, m.str());
+  }
+  const double window_s = n > 1 ? std::max((window_.back().at - window_.front().at).toSec(), 1e-3) : 0.0;
+  status.add("input rate (Hz)", window_s > 0 ? (n - 1) / window_s : 0.0);
+  status.add("trained (%, last 5 s)", percent(trained, n));
+  status.add("rejected (%, last 5 s)", percent(rejected, n));
+  status.add("without pose (%, last 5 s)", percent(no_pose, n));
+  status.add("cycle time mean (ms, last 5 s)", cycles ? sum_ms / cycles : 0.0);
+  status.add("cycle time max (ms, last 5 s)", max_ms);
+  status.add("start-up training (ms)", startup_ms_);
+  status.add("latency image stamp to table mean (ms, last 5 s)", latencies ? sum_latency / latencies : 0.0);
+  status.add("latency image stamp to table max (ms, last 5 s)", max_latency);
   status.add("images", images_);
   status.add("cycles", cycles_);
   status.add("images without training (no pose)", skipped_);
   status.add("images rejected", rejected_);
+  status.add("images waiting for their pose", pending_.size());
   status.add("last skip reason", last_skip_reason_);
+  status.add("last rejection", last_reject_reason_);
   status.add("poses rejected", pose_source_.rejected());
-  status.add("cycle time last (ms)", last_cycle_ms_);
-  status.add("cycle time mean (ms)", cycles_ ? sum_cycle_ms_ / cycles_ : 0.0);
-  status.add("cycle time max (ms)", max_cycle_ms_);
+  status.add("time jumps back", time_jumps_);
   status.add("table revision", trainer_->revision());
-  const auto counts = trainer_->lut().cellCounts();
-  uint64_t filled = 0;
-  for (int k = 1; k < core::kNumClasses; ++k) filled += counts[k];
-  status.add("table fill (%)", 100.0 * filled / trainer_->lut().size());
+  status.add("table fill (%)", fill_percent);
   for (int k = 1; k < core::kNumClasses; ++k) {
     const core::ClassCluster& c = trainer_->clusters()[k];
     std::ostringstream s;

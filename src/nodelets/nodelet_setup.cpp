@@ -1,18 +1,20 @@
 #include "act_color/ros/nodelet_setup.hpp"
 
 #include <exception>
+#include <sstream>
 
 namespace act_color {
 namespace ros_conversions {
 
 std::unique_ptr<diagnostic_updater::Updater> makeDiagnostics(
     ros::NodeHandle& nh, ros::NodeHandle& pnh, const std::string& node_name, const std::string& task,
-    const std::function<void(diagnostic_updater::DiagnosticStatusWrapper&)>& diagnose, ros::Timer* timer) {
+    const std::function<void(diagnostic_updater::DiagnosticStatusWrapper&)>& diagnose, ros::WallTimer* timer) {
   auto updater = std::make_unique<diagnostic_updater::Updater>(nh, pnh, node_name);
   updater->setHardwareID("act_color");
   updater->add(task, diagnose);
   diagnostic_updater::Updater* raw = updater.get();
-  *timer = nh.createTimer(ros::Duration(1.0), [raw](const ros::TimerEvent&) { raw->update(); });
+  // force_update: Updater::update() waits for ROS time to pass its period.
+  *timer = nh.createWallTimer(ros::WallDuration(1.0), [raw](const ros::WallTimerEvent&) { raw->force_update(); });
   return updater;
 }
 
@@ -28,7 +30,7 @@ std::string runConfigure(const std::function<bool(std::string*)>& configure) {
 
 bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,
                           std::string* error) {
-  *path = pnh.param<std::string>("calibration", "");
+  if (!readParam(pnh, "calibration", path, error)) return false;
   if (path->empty()) {
     *error = "parameter ~calibration (path of the calibration file) is not set";
     return false;
@@ -39,6 +41,89 @@ bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibra
     *error = std::string("bad calibration: ") + e.what();
     return false;
   }
+  return true;
+}
+
+namespace {
+
+const char* typeName(XmlRpc::XmlRpcValue::Type type) {
+  switch (type) {
+    case XmlRpc::XmlRpcValue::TypeBoolean:
+      return "a boolean";
+    case XmlRpc::XmlRpcValue::TypeInt:
+      return "an integer";
+    case XmlRpc::XmlRpcValue::TypeDouble:
+      return "a number";
+    case XmlRpc::XmlRpcValue::TypeString:
+      return "a string";
+    case XmlRpc::XmlRpcValue::TypeArray:
+      return "a list";
+    case XmlRpc::XmlRpcValue::TypeStruct:
+      return "a dictionary";
+    default:
+      return "of no known type";
+  }
+}
+
+// The parameter when set; *set false when it is not.
+bool fetch(const ros::NodeHandle& nh, const std::string& name, XmlRpc::XmlRpcValue* value, bool* set) {
+  *set = nh.hasParam(name) && nh.getParam(name, *value);
+  return *set;
+}
+
+bool wrongType(const std::string& name, XmlRpc::XmlRpcValue& value, const char* expected, std::string* error) {
+  std::ostringstream s;
+  s << "parameter ~" << name << " must be " << expected << ", is ";
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeString) {
+    s << "'" << static_cast<std::string&>(value) << "'";
+  } else {
+    value.write(s);
+  }
+  s << " (" << typeName(value.getType()) << ")";
+  *error = s.str();
+  return false;
+}
+
+}  // namespace
+
+bool readParam(const ros::NodeHandle& nh, const std::string& name, double* value, std::string* error) {
+  XmlRpc::XmlRpcValue v;
+  bool set = false;
+  if (!fetch(nh, name, &v, &set)) return true;
+  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+    *value = static_cast<double>(v);
+  } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+    *value = static_cast<int>(v);
+  } else {
+    return wrongType(name, v, "a number", error);
+  }
+  return true;
+}
+
+bool readParam(const ros::NodeHandle& nh, const std::string& name, int* value, std::string* error) {
+  XmlRpc::XmlRpcValue v;
+  bool set = false;
+  if (!fetch(nh, name, &v, &set)) return true;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) return wrongType(name, v, "an integer", error);
+  *value = static_cast<int>(v);
+  return true;
+}
+
+bool readParam(const ros::NodeHandle& nh, const std::string& name, bool* value, std::string* error) {
+  XmlRpc::XmlRpcValue v;
+  bool set = false;
+  if (!fetch(nh, name, &v, &set)) return true;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) return wrongType(name, v, "true or false", error);
+  *value = static_cast<bool>(v);
+  return true;
+}
+
+bool readParam(const ros::NodeHandle& nh, const std::string& name, std::string* value, std::string* error) {
+  XmlRpc::XmlRpcValue v;
+  bool set = false;
+  if (!fetch(nh, name, &v, &set)) return true;
+  if (v.getType() != XmlRpc::XmlRpcValue::TypeString) return wrongType(name, v, "a string", error);
+  *value = static_cast<std::string&>(v);
   return true;
 }
 

@@ -2,9 +2,11 @@
 
 #include <geometry_msgs/TransformStamped.h>
 
+#include <algorithm>
 #include <sstream>
 
 #include "act_color/ros/conversions.hpp"
+#include "act_color/ros/nodelet_setup.hpp"
 
 namespace act_color {
 namespace ros_conversions {
@@ -15,10 +17,15 @@ constexpr size_t kMaxPoses = 200;
 
 bool PoseSource::init(ros::NodeHandle& nh, ros::NodeHandle& pnh, const std::string& name, std::string* error) {
   name_ = name;
-  std::string source = pnh.param<std::string>("pose_source", "topic");
-  max_age_s_ = pnh.param("max_pose_age", 1.0);
-  field_frame_ = pnh.param<std::string>("field_frame", "field");
-  base_frame_ = pnh.param<std::string>("base_frame", "base_link");
+  std::string source = "topic";
+  if (!readParam(pnh, "pose_source", &source, error) || !readParam(pnh, "max_pose_age", &max_age_s_, error) ||
+      !readParam(pnh, "field_frame", &field_frame_, error) || !readParam(pnh, "base_frame", &base_frame_, error)) {
+    return false;
+  }
+  if (!(max_age_s_ > 0.0 && max_age_s_ <= 60.0)) {
+    *error = "parameter ~max_pose_age must be in (0, 60] s, is " + std::to_string(max_age_s_);
+    return false;
+  }
   if (source == "topic") {
     mode_ = Mode::kTopic;
     sub_ = nh.subscribe("pose", 20, &PoseSource::onPose, this);
@@ -42,16 +49,25 @@ void PoseSource::onPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& 
   if (!pose2D(msg->pose.pose, &pose, &error)) {
     ++rejected_;
     last_rejection_ = "pose stamped " + std::to_string(msg->header.stamp.toSec()) + " rejected: " + error;
-    ROS_ERROR_THROTTLE(5.0, "%s: %s", name_.c_str(), last_rejection_.c_str());
+    ACT_WALL_THROTTLE(5.0, ROS_ERROR("%s: %s", name_.c_str(), last_rejection_.c_str()));
     return;
   }
   if (!msg->header.frame_id.empty() && msg->header.frame_id != field_frame_ &&
       msg->header.frame_id != "/" + field_frame_) {
     ++rejected_;
     last_rejection_ = "pose in frame '" + msg->header.frame_id + "' rejected: expected '" + field_frame_ + "'";
-    ROS_ERROR_THROTTLE(5.0, "%s: %s", name_.c_str(), last_rejection_.c_str());
+    ACT_WALL_THROTTLE(5.0, ROS_ERROR("%s: %s", name_.c_str(), last_rejection_.c_str()));
     return;
   }
+  if (!newest_stamp_.isZero() && msg->header.stamp + ros::Duration(TimeJumpDetector::kJumpBackS) < newest_stamp_) {
+    // A new replay of a bag: the poses of the old run would be taken for this one's.
+    ROS_WARN("%s: pose stamps jumped back from %.3f to %.3f: forgetting the %zu poses before", name_.c_str(),
+             newest_stamp_.toSec(), msg->header.stamp.toSec(), poses_.size());
+    poses_.clear();
+    newest_stamp_ = ros::Time();
+    ++time_jumps_;
+  }
+  if (msg->header.stamp > newest_stamp_) newest_stamp_ = msg->header.stamp;
   poses_.emplace_back(msg->header.stamp, pose);
   while (poses_.size() > kMaxPoses) poses_.pop_front();
 }
@@ -59,7 +75,7 @@ void PoseSource::onPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& 
 bool PoseSource::lookup(const ros::Time& stamp, core::Pose2D* pose, std::string* why) {
   if (mode_ == Mode::kTf) {
     try {
-      // Zero timeout: never waits for tf.
+      // Zero timeout: never waits for tf here (the caller holds the image, mayStillCome()).
       const geometry_msgs::TransformStamped t = tf_buffer_->lookupTransform(field_frame_, base_frame_, stamp);
       geometry_msgs::Pose p;
       p.position.x = t.transform.translation.x;
@@ -97,6 +113,46 @@ bool PoseSource::lookup(const ros::Time& stamp, core::Pose2D* pose, std::string*
   }
   *pose = best->second;
   return true;
+}
+
+bool PoseSource::mayStillCome(const ros::Time& stamp) const {
+  if (mode_ == Mode::kTf) {
+    try {
+      // The newest transform there is: a later one for `stamp` may still come while it is older.
+      const geometry_msgs::TransformStamped t = tf_buffer_->lookupTransform(field_frame_, base_frame_, ros::Time(0));
+      return t.header.stamp < stamp;
+    } catch (const std::exception&) {
+      return true;  // no transform yet at all
+    }
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  return newest_stamp_ < stamp;
+}
+
+void PoseSource::forgetNewerThan(const ros::Time& stamp) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  poses_.erase(std::remove_if(poses_.begin(), poses_.end(), [&](const auto& p) { return p.first > stamp; }),
+               poses_.end());
+  newest_stamp_ = ros::Time();
+  for (const auto& p : poses_) newest_stamp_ = std::max(newest_stamp_, p.first);
+  if (tf_buffer_) {
+    try {
+      if (tf_buffer_->lookupTransform(field_frame_, base_frame_, ros::Time(0)).header.stamp > stamp)
+        tf_buffer_->clear();
+    } catch (const std::exception&) {
+      // nothing there to forget
+    }
+  }
+}
+
+void PoseSource::setMaxAge(double max_age_s) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  max_age_s_ = max_age_s;
+}
+
+uint64_t PoseSource::timeJumps() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return time_jumps_;
 }
 
 uint64_t PoseSource::received() const {

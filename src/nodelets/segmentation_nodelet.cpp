@@ -10,6 +10,7 @@
 #include <std_msgs/UInt64MultiArray.h>
 
 #include <boost/make_shared.hpp>
+#include <chrono>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -17,11 +18,13 @@
 #include <string>
 
 #include "act_color/ColorLut.h"
+#include "act_color/SegmentationConfig.h"
 #include "act_color/VisionFeatures.h"
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/feature_extractor.hpp"
 #include "act_color/core/omni_camera_model.hpp"
 #include "act_color/core/segmenter.hpp"
+#include "act_color/ros/checked_reconfigure.hpp"
 #include "act_color/ros/conversions.hpp"
 #include "act_color/ros/nodelet_setup.hpp"
 #include "act_color/ros/pose_source.hpp"
@@ -34,14 +37,25 @@ class SegmentationNodelet : public nodelet::Nodelet {
     sensor_msgs::ImageConstPtr image;
     ros::WallTime arrival;
   };
+  // Which table an image was classified with (diagnostics).
+  enum class TableUsed { kExact, kOlder, kNewest, kNone, kRejected };
+  struct Record {
+    ros::WallTime at;
+    TableUsed table;
+    double classify_ms;
+    double latency_ms;  // image stamp to labels (ROS time)
+  };
 
   void onInit() override;
   bool configure(std::string* error);
+  bool applyConfig(const SegmentationConfig& config, std::string* error);
   void connectCb();
   void onImage(const sensor_msgs::ImageConstPtr& msg);
   void onTable(const act_color::ColorLutConstPtr& msg);
   void flush();
-  void process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut);
+  // The classify time in ms.
+  double process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut);
+  void record(TableUsed table, double classify_ms, double latency_ms);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
@@ -52,13 +66,15 @@ class SegmentationNodelet : public nodelet::Nodelet {
   ros::Publisher features_pub_, debug_pub_;
   ros::WallTimer flush_timer_;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
-  ros::Timer diagnostics_timer_;
+  ros::WallTimer diagnostics_timer_;
   ros_conversions::PoseSource pose_source_;
+  std::unique_ptr<ros_conversions::CheckedReconfigure<SegmentationConfig>> reconfigure_;
 
   std::mutex mutex_;  // guards everything below
   std::string config_error_;
   std::unique_ptr<core::OmniCameraModel> camera_;
   std::unique_ptr<core::Segmenter> segmenter_;
+  core::FieldCalibration field_;
   core::FeatureParams feature_params_;
   bool lazy_ = false;
   bool debug_addresses_ = false;
@@ -67,8 +83,17 @@ class SegmentationNodelet : public nodelet::Nodelet {
   size_t table_history_ = 10;
   std::deque<PendingImage> pending_;                // by arrival
   std::deque<act_color::ColorLutConstPtr> tables_;  // shared, never copied; by arrival
-  // Statistics.
-  uint64_t images_ = 0, labeled_ = 0, exact_table_ = 0, older_table_ = 0, no_table_ = 0, rejected_ = 0;
+  // The newest table before time jumped back: used until a table of the new run comes.
+  act_color::ColorLutConstPtr fallback_;
+  ros_conversions::TimeJumpDetector image_time_;
+  // Statistics since the start (or the last time jump) ...
+  uint64_t images_ = 0, labeled_ = 0, exact_table_ = 0, older_table_ = 0, newest_table_ = 0, no_table_ = 0,
+           rejected_ = 0, time_jumps_ = 0;
+  std::string last_error_;
+  // ... and of the last seconds.
+  static constexpr double kWindowS = 5.0;
+  std::deque<Record> window_;
+  ros::WallTime last_image_, last_table_;
 };
 
 void SegmentationNodelet::onInit() {
@@ -86,21 +111,22 @@ void SegmentationNodelet::onInit() {
 }
 
 bool SegmentationNodelet::configure(std::string* error) {
+  using ros_conversions::readParam;
   core::Calibration calibration;
   std::string calibration_path;
   if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, error)) return false;
-  const int queue_size = pnh_.param("queue_size", 5);
-  const double max_wait = pnh_.param("max_wait", 0.2);
-  const int history = pnh_.param("table_history", 10);
-  if (queue_size < 1 || queue_size > 100 || !(max_wait >= 0.0 && max_wait <= 10.0) || history < 1 || history > 100) {
-    *error = "~queue_size must be in [1, 100], ~max_wait in [0, 10] s, ~table_history in [1, 100]";
-    return false;
-  }
-  core::FeatureParams fp;
-  fp.scan_lines = pnh_.param("scan_lines", fp.scan_lines);
-  fp.min_ball_pixels = pnh_.param("min_ball_pixels", fp.min_ball_pixels);
-  if (fp.scan_lines < 4 || fp.scan_lines > 3600) {
-    *error = "~scan_lines must be in [4, 3600]";
+  SegmentationConfig c = SegmentationConfig::__getDefault__();
+  bool lazy = false, debug = false;
+  if (!readParam(pnh_, "queue_size", &c.queue_size, error) || !readParam(pnh_, "max_wait", &c.max_wait, error) ||
+      !readParam(pnh_, "table_history", &c.table_history, error) ||
+      !readParam(pnh_, "max_pose_age", &c.max_pose_age, error) ||
+      !readParam(pnh_, "scan_lines", &c.scan_lines, error) ||
+      !readParam(pnh_, "max_line_run_px", &c.max_line_run_px, error) ||
+      !readParam(pnh_, "min_goal_run_px", &c.min_goal_run_px, error) ||
+      !readParam(pnh_, "min_obstacle_run_px", &c.min_obstacle_run_px, error) ||
+      !readParam(pnh_, "min_ball_pixels", &c.min_ball_pixels, error) ||
+      !readParam(pnh_, "obstacle_merge_m", &c.obstacle_merge_m, error) || !readParam(pnh_, "lazy", &lazy, error) ||
+      !readParam(pnh_, "debug_lut_addresses", &debug, error)) {
     return false;
   }
   if (!pose_source_.init(nh_, pnh_, getName(), error)) return false;
@@ -108,13 +134,11 @@ bool SegmentationNodelet::configure(std::string* error) {
     std::lock_guard<std::mutex> lock(mutex_);
     camera_ = std::make_unique<core::OmniCameraModel>(calibration.camera);
     segmenter_ = std::make_unique<core::Segmenter>(calibration.camera);
-    feature_params_ = fp;
-    queue_size_ = static_cast<size_t>(queue_size);
-    max_wait_s_ = max_wait;
-    table_history_ = static_cast<size_t>(history);
-    lazy_ = pnh_.param("lazy", false);
-    debug_addresses_ = pnh_.param("debug_lut_addresses", false);
+    field_ = calibration.field;
+    lazy_ = lazy;
+    debug_addresses_ = debug;
   }
+  if (!applyConfig(c, error)) return false;
   if (debug_addresses_) debug_pub_ = pnh_.advertise<std_msgs::UInt64MultiArray>("received_lut", 100);
   it_ = std::make_unique<image_transport::ImageTransport>(nh_);
   image_transport::SubscriberStatusCallback it_cb = [this](const image_transport::SingleSubscriberPublisher&) {
@@ -125,16 +149,59 @@ bool SegmentationNodelet::configure(std::string* error) {
   // The labels in the classes' palette, for rviz; only computed while someone listens.
   labels_color_pub_ = it_->advertise("labels_color", 1, it_cb, it_cb);
   features_pub_ = nh_.advertise<act_color::VisionFeatures>("features", 2, cb, cb);
+  reconfigure_ = std::make_unique<ros_conversions::CheckedReconfigure<SegmentationConfig>>(
+      pnh_, c, [this](const SegmentationConfig& config, std::string* e) { return applyConfig(config, e); },
+      [this](const std::string& e) {
+        ACT_WALL_THROTTLE(0.2,
+                          NODELET_ERROR("dynamic_reconfigure: %s; not applied, the previous values stay", e.c_str()));
+      });
   flush_timer_ = nh_.createWallTimer(ros::WallDuration(0.02), [this](const ros::WallTimerEvent&) {
     try {
       flush();
     } catch (const std::exception& e) {
-      NODELET_ERROR_THROTTLE(5.0, "%s", e.what());
+      ACT_WALL_THROTTLE(5.0, NODELET_ERROR("%s", e.what()));
     }
   });
   connectCb();
   NODELET_INFO("segmentation ready: calibration %s, %s", calibration_path.c_str(),
                lazy_ ? "inputs subscribed while someone listens" : "always subscribed");
+  return true;
+}
+
+bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* error) {
+  core::FeatureParams fp;
+  fp.scan_lines = c.scan_lines;
+  fp.max_line_run_px = c.max_line_run_px;
+  fp.min_goal_run_px = c.min_goal_run_px;
+  fp.min_obstacle_run_px = c.min_obstacle_run_px;
+  fp.min_ball_pixels = c.min_ball_pixels;
+  fp.obstacle_merge_m = c.obstacle_merge_m;
+  std::ostringstream s;
+  if (!(c.queue_size >= 1 && c.queue_size <= 100)) {
+    s << "parameter queue_size must be in [1, 100], is " << c.queue_size;
+  } else if (!(c.max_wait >= 0.0 && c.max_wait <= 10.0)) {
+    s << "parameter max_wait must be in [0, 10] s, is " << c.max_wait;
+  } else if (!(c.table_history >= 1 && c.table_history <= 100)) {
+    s << "parameter table_history must be in [1, 100], is " << c.table_history;
+  } else if (!(c.max_pose_age > 0.0 && c.max_pose_age <= 60.0)) {
+    s << "parameter max_pose_age must be in (0, 60] s, is " << c.max_pose_age;
+  } else {
+    try {
+      fp.validate();
+    } catch (const std::exception& e) {
+      s << e.what();
+    }
+  }
+  if (!s.str().empty()) {
+    *error = s.str();
+    return false;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  feature_params_ = fp;
+  queue_size_ = static_cast<size_t>(c.queue_size);
+  max_wait_s_ = c.max_wait;
+  table_history_ = static_cast<size_t>(c.table_history);
+  pose_source_.setMaxAge(c.max_pose_age);
   return true;
 }
 
@@ -159,12 +226,29 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!segmenter_) return;
+      const ros::Time before = image_time_.latest();
+      if (image_time_.jumpedBack(msg->header.stamp)) {
+        // A new replay: the old run's tables are stamped in this run's future and would be taken
+        // for trained tables. The newest stays as a fallback until this run's first table.
+        ++time_jumps_;
+        NODELET_WARN(
+            "time jumped back from %.3f to %.3f (a new replay?): tables, waiting images and statistics "
+            "start afresh",
+            before.toSec(), msg->header.stamp.toSec());
+        if (!tables_.empty()) fallback_ = tables_.back();
+        tables_.clear();
+        pending_.clear();
+        window_.clear();
+        images_ = labeled_ = exact_table_ = older_table_ = newest_table_ = no_table_ = rejected_ = 0;
+        pose_source_.forgetNewerThan(msg->header.stamp + ros::Duration(ros_conversions::TimeJumpDetector::kJumpBackS));
+      }
       ++images_;
-      pending_.push_back({msg, ros::WallTime::now()});
+      last_image_ = ros::WallTime::now();
+      pending_.push_back({msg, last_image_});
     }
     flush();
   } catch (const std::exception& e) {
-    NODELET_ERROR_THROTTLE(5.0, "image stamped %.3f: %s", msg->header.stamp.toSec(), e.what());
+    ACT_WALL_THROTTLE(5.0, NODELET_ERROR("image stamped %.3f: %s", msg->header.stamp.toSec(), e.what()));
   }
 }
 
@@ -180,20 +264,24 @@ void SegmentationNodelet::onTable(const act_color::ColorLutConstPtr& msg) {
       if (!segmenter_) return;
       tables_.push_back(msg);  // keeps the shared pointer: no copy of the table
       while (tables_.size() > table_history_) tables_.pop_front();
+      last_table_ = ros::WallTime::now();
     }
     flush();
   } catch (const std::exception& e) {
-    NODELET_ERROR_THROTTLE(5.0, "color table stamped %.3f: %s", msg->header.stamp.toSec(), e.what());
+    ACT_WALL_THROTTLE(5.0, NODELET_ERROR("color table stamped %.3f: %s", msg->header.stamp.toSec(), e.what()));
   }
 }
 
 // Classifies the waiting images whose table is known. Image t takes the table stamped t; once a
 // later table exists, or the image waited ~max_wait or the queue is full (the trainer skipped
-// it or is not running), it takes the latest table stamped before t. Every image is published.
+// it or is not running), it takes the latest table stamped before t, else the newest there is
+// (after time jumped back, or for an image older than every table kept). Every image is published;
+// all unknown only while there is no table at all, and diagnostics say so.
 void SegmentationNodelet::flush() {
   while (true) {
     sensor_msgs::ImageConstPtr image;
     act_color::ColorLutConstPtr lut;
+    TableUsed used = TableUsed::kNone;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (pending_.empty()) return;
@@ -206,50 +294,70 @@ void SegmentationNodelet::flush() {
         if (s < t && (!before || s >= before->header.stamp)) before = table;
         if (s > t) after = table;
       }
-      const bool timed_out = (ros::WallTime::now() - front.arrival).toSec() >= max_wait_s_;
+      const double waited = (ros::WallTime::now() - front.arrival).toSec();
       if (exact) {
         lut = exact;
+        used = TableUsed::kExact;
         ++exact_table_;
-      } else if (after || timed_out || pending_.size() > queue_size_) {
-        lut = before;
+      } else if (after || waited >= max_wait_s_ || pending_.size() > queue_size_) {
         if (before) {
+          lut = before;
+          used = TableUsed::kOlder;
           ++older_table_;
+          if (!after) {
+            ACT_WALL_THROTTLE(5.0, NODELET_WARN("no table trained on the image stamped %.3f after %.2f s: using the "
+                                                "one of %.3f",
+                                                t.toSec(), waited, before->header.stamp.toSec()));
+          }
+        } else if (!tables_.empty() || fallback_) {
+          lut = !tables_.empty() ? tables_.back() : fallback_;
+          used = TableUsed::kNewest;
+          ++newest_table_;
+          ACT_WALL_THROTTLE(5.0, NODELET_WARN("no table stamped at or before the image stamped %.3f: using the newest "
+                                              "(stamped %.3f)",
+                                              t.toSec(), lut->header.stamp.toSec()));
         } else {
           ++no_table_;
-        }
-        if (!after && !before) {
-          NODELET_WARN_THROTTLE(5.0,
-                                "no color table for the image stamped %.3f yet (is the ACT trainer running?): "
-                                "labels are all unknown",
-                                t.toSec());
-        } else if (!after) {
-          NODELET_WARN_THROTTLE(5.0, "no table trained on the image stamped %.3f after %.2f s: using the one of %.3f",
-                                t.toSec(), (ros::WallTime::now() - front.arrival).toSec(),
-                                before->header.stamp.toSec());
+          ACT_WALL_THROTTLE(5.0, NODELET_WARN("no color table for the image stamped %.3f yet (is the ACT trainer "
+                                              "running?): labels are all unknown",
+                                              t.toSec()));
         }
       } else {
         return;  // the table of this image is on its way
       }
+      if (used != TableUsed::kNewest && used != TableUsed::kNone) fallback_.reset();
       image = front.image;
       pending_.pop_front();
     }
     try {
-      process(image, lut);
+      const double classify_ms = process(image, lut);
+      std::lock_guard<std::mutex> lock(mutex_);
+      record(used, classify_ms, (ros::Time::now() - image->header.stamp).toSec() * 1000.0);
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
       ++rejected_;
-      NODELET_ERROR_THROTTLE(5.0, "image stamped %.3f not classified: %s", image->header.stamp.toSec(), e.what());
+      last_error_ = e.what();
+      record(TableUsed::kRejected, 0.0, -1.0);
+      ACT_WALL_THROTTLE(5.0,
+                        NODELET_ERROR("image stamped %.3f not classified: %s", image->header.stamp.toSec(), e.what()));
     }
   }
 }
 
-void SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut) {
+void SegmentationNodelet::record(TableUsed table, double classify_ms, double latency_ms) {
+  const ros::WallTime now = ros::WallTime::now();
+  window_.push_back({now, table, classify_ms, latency_ms});
+  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+}
+
+double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut) {
   core::ImageView view;
   std::string error;
   if (!ros_conversions::imageView(*image, &view, &error)) throw std::invalid_argument(error);
   // Labels written straight into the outgoing message.
   cv::Mat labels;
   sensor_msgs::ImagePtr labels_msg = ros_conversions::newLabelsMsg(*image, &labels);
+  const auto start = std::chrono::steady_clock::now();
   if (lut) {
     segmenter_->classify(ros_conversions::lutView(*lut), view, labels);  // throws for a wrong size or color space
   } else if (image->width != static_cast<uint32_t>(camera_->width()) ||
@@ -258,16 +366,24 @@ void SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const
                                 " px, the calibration is for " + std::to_string(camera_->width()) + "x" +
                                 std::to_string(camera_->height()));
   }
+  const double classify_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   if (features_pub_.getNumSubscribers() > 0) {
     auto features = boost::make_shared<act_color::VisionFeatures>();
     features->header = image->header;
     features->lut_revision = lut ? lut->revision : 0;
-    std::vector<core::Feature> found = core::extractFeatures(labels, *camera_, feature_params_);
+    core::FeatureParams params;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      params = feature_params_;
+    }
+    std::vector<core::Feature> found = core::extractFeatures(labels, *camera_, params);
     core::Pose2D pose;
     std::string why;
     features->pose_valid = pose_source_.lookup(image->header.stamp, &pose, &why);
     if (features->pose_valid) {
       core::toField(pose, &found);
+      core::removeOffField(field_, &found);  // hall clutter and people beyond the carpet
       features->pose.x = pose.x_m;
       features->pose.y = pose.y_m;
       features->pose.theta = pose.theta_rad;
@@ -297,28 +413,86 @@ void SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const
   labels_pub_.publish(boost::shared_ptr<const sensor_msgs::Image>(labels_msg));
   std::lock_guard<std::mutex> lock(mutex_);
   ++labeled_;
+  return classify_ms;
 }
 
 void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
   if (!config_error_.empty() || !segmenter_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "not configured: " + config_error_);
+    status.summary(DiagnosticStatus::ERROR, "not configured: " + config_error_);
     return;
   }
-  if (images_ == 0) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no image received yet");
-  } else if (no_table_ > 0 && labeled_ == no_table_) {
-    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "no color table received");
-  } else {
-    status.summary(diagnostic_msgs::DiagnosticStatus::OK, "segmenting");
+  const ros::WallTime now = ros::WallTime::now();
+  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+  size_t counts[5] = {0, 0, 0, 0, 0};
+  double sum_ms = 0, max_ms = 0, sum_latency = 0, max_latency = 0;
+  size_t classified = 0;
+  for (const Record& r : window_) {
+    ++counts[static_cast<int>(r.table)];
+    if (r.table == TableUsed::kRejected) continue;
+    ++classified;
+    sum_ms += r.classify_ms;
+    max_ms = std::max(max_ms, r.classify_ms);
+    sum_latency += r.latency_ms;
+    max_latency = std::max(max_latency, r.latency_ms);
   }
+  const size_t n = window_.size();
+  auto percent = [](double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0.0; };
+  const size_t exact = counts[static_cast<int>(TableUsed::kExact)];
+  const size_t none = counts[static_cast<int>(TableUsed::kNone)];
+  const size_t rejected = counts[static_cast<int>(TableUsed::kRejected)];
+  const size_t stale = counts[static_cast<int>(TableUsed::kOlder)] + counts[static_cast<int>(TableUsed::kNewest)];
+  const double since_image = last_image_.isZero() ? -1.0 : (now - last_image_).toSec();
+  const double since_table = last_table_.isZero() ? -1.0 : (now - last_table_).toSec();
+  std::ostringstream m;
+  m.precision(3);
+  status.summary(DiagnosticStatus::OK, "segmenting");
+  const bool waiting_for_subscribers = lazy_ && !image_sub_;
+  if (waiting_for_subscribers) {
+    status.summary(DiagnosticStatus::OK, "idle: nobody subscribes to the labels or features");
+  } else if (images_ == 0) {
+    status.summary(DiagnosticStatus::WARN, "no image received yet");
+  } else if (since_image > 2.0) {
+    m << "no image for " << since_image << " s (input stale)";
+    status.summary(DiagnosticStatus::WARN, m.str());
+  } else {
+    if (n > 0 && none == n) {
+      status.mergeSummary(DiagnosticStatus::ERROR, "no color table received: labels are all unknown");
+    } else if (since_table > 2.0 || (since_table < 0 && n > 0)) {
+      m << "no new color table for " << since_table << " s (is the ACT trainer running?): labels from an old table";
+      status.mergeSummary(DiagnosticStatus::WARN, m.str());
+      m.str("");
+    } else if (n > 0 && stale > 0.1 * n) {
+      m << percent(stale, n) << "% of the images classified with an older table (frames not trained)";
+      status.mergeSummary(DiagnosticStatus::WARN, m.str());
+      m.str("");
+    }
+    if (rejected > 0) {
+      m << rejected << " of " << n << " images in " << kWindowS << " s not classified: " << last_error_;
+      status.mergeSummary(rejected == n ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, m.str());
+    }
+  }
+  const double window_s = n > 1 ? std::max((window_.back().at - window_.front().at).toSec(), 1e-3) : 0.0;
+  status.add("label rate (Hz)", window_s > 0 ? (n - 1) / window_s : 0.0);
+  status.add("with the table of the same frame (%, last 5 s)", percent(exact, n));
+  status.add("with an older or the newest table (%, last 5 s)", percent(stale, n));
+  status.add("without a table, all unknown (%, last 5 s)", percent(none, n));
+  status.add("classify time mean (ms, last 5 s)", classified ? sum_ms / classified : 0.0);
+  status.add("classify time max (ms, last 5 s)", max_ms);
+  status.add("latency image stamp to labels mean (ms, last 5 s)", classified ? sum_latency / classified : 0.0);
+  status.add("latency image stamp to labels max (ms, last 5 s)", max_latency);
+  status.add("seconds since the last table", since_table);
   status.add("images", images_);
   status.add("labels published", labeled_);
   status.add("with the table of the same frame", exact_table_);
   status.add("with an older table (frame not trained)", older_table_);
+  status.add("with the newest table (none at or before the frame)", newest_table_);
   status.add("without a table (all unknown)", no_table_);
   status.add("images rejected", rejected_);
+  status.add("last rejection", last_error_);
   status.add("images waiting", pending_.size());
+  status.add("time jumps back", time_jumps_);
   status.add("last table revision", tables_.empty() ? 0 : tables_.back()->revision);
 }
 

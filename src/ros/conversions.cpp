@@ -76,8 +76,29 @@ bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* e
     *error = "table has " + std::to_string(msg.table.size()) + " cells, expected " + std::to_string(out.size());
     return false;
   }
+  for (size_t i = 0; i < msg.table.size(); ++i) {
+    if (msg.table[i] >= core::kNumClasses) {
+      *error = "cell " + std::to_string(i) + " has class id " + std::to_string(msg.table[i]) + " (classes are 0-" +
+               std::to_string(core::kNumClasses - 1) + ")";
+      return false;
+    }
+  }
   out.assign(msg.table);
   *lut = std::move(out);
+  return true;
+}
+
+bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::vector<core::ActTrainer::SavedCluster>* clusters,
+             std::string* error) {
+  if (!fromMsg(msg, lut, error)) return false;
+  clusters->clear();
+  for (const act_color::ClassCluster& c : msg.clusters) {
+    core::ActTrainer::SavedCluster saved;
+    saved.class_id = c.class_id;
+    saved.mean = Eigen::Vector3d(c.mean[0], c.mean[1], c.mean[2]);
+    saved.sigma = c.sigma;
+    clusters->push_back(saved);
+  }
   return true;
 }
 

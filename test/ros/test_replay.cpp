@@ -30,6 +30,9 @@ TEST(Replay, LabelsForEveryFrame) {
   std::vector<double> min_recall, min_precision;
   ASSERT_TRUE(pnh.getParam("min_recall", min_recall));
   ASSERT_TRUE(pnh.getParam("min_precision", min_precision));
+  // Of the images, those trained on (the table's revision went up with them).
+  const double min_trained = pnh.param("min_trained_fraction", 1.0);
+  const std::string pose_source = pnh.param<std::string>("pose_source", "topic");
 
   // What the bag holds: image stamps and truth labels.
   std::set<ros::Time> image_stamps;
@@ -94,11 +97,12 @@ TEST(Replay, LabelsForEveryFrame) {
     trained += revision > previous ? 1 : 0;
     previous = revision;
   }
-  std::printf("tables for %zu images, %zu of them trained on their image, last revision %lu\n", revisions.size(),
-              trained, static_cast<unsigned long>(previous));
+  std::printf("pose from %s: tables for %zu images, %zu of them (%.1f%%) trained on their image, last revision %lu\n",
+              pose_source.c_str(), revisions.size(), trained, 100.0 * trained / image_stamps.size(),
+              static_cast<unsigned long>(previous));
   EXPECT_TRUE(all) << "timed out after " << timeout << " s";
   EXPECT_EQ(revisions.size(), image_stamps.size()) << "images without a table";
-  EXPECT_EQ(trained, image_stamps.size()) << "images the trainer did not train on";
+  EXPECT_GE(trained, min_trained * image_stamps.size()) << "images the trainer did not train on";
   EXPECT_EQ(labeled, image_stamps.size()) << "images without labels";
   EXPECT_EQ(labels.size(), labeled) << "labels with stamps of no image in the bag";
   EXPECT_EQ(duplicates, 0u);

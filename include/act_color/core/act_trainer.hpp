@@ -143,6 +143,17 @@ class ActTrainer {
   void reset(ColorSpace space);
   // Installs a saved table (e.g. from a file); throws std::invalid_argument if sizes differ.
   void loadTable(const ColorLut& lut);
+  // A cluster as saved with its table (ColorLut message, ~save_lut file).
+  struct SavedCluster {
+    int class_id = 0;  // 1 .. kNumClasses - 1
+    Eigen::Vector3d mean;
+    double sigma = 0;
+  };
+  // Installs a saved state: the table, the clusters it was trained with and its revision, so that
+  // training goes on where it stopped. A class whose cluster is not given, or that has no cell in
+  // the table, starts at eq. 2-3. Throws std::invalid_argument for sizes that differ or a cluster
+  // that is not one (class id, NaN, sigma <= 0, mean outside the channel range).
+  void restore(const ColorLut& lut, const std::vector<SavedCluster>& clusters, uint64_t revision);
 
   const ColorLut& lut() const { return lut_; }
   const std::array<ClassCluster, kNumClasses>& clusters() const { return clusters_; }

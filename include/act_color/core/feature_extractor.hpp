@@ -32,6 +32,9 @@ struct FeatureParams {
   int min_obstacle_run_px = 4;
   int min_ball_pixels = 6;        // orange blobs smaller than this are noise
   double obstacle_merge_m = 0.5;  // neighbouring scan lines' obstacle feet closer than this merge
+
+  // Throws std::invalid_argument naming the first parameter out of its range and its value.
+  void validate() const;
 };
 
 // Features of a label image (class ids, the camera's size) by radial scan lines from the chassis
@@ -40,6 +43,11 @@ struct FeatureParams {
 // label image does not fit the camera.
 std::vector<Feature> extractFeatures(const cv::Mat& labels, const OmniCameraModel& camera,
                                      const FeatureParams& params = FeatureParams());
+
+// Drops the features whose field point lies beyond the carpet (the outer lines plus the field's
+// margin, or the goals' depth where that is larger): hall clutter, people and the robots' own
+// reflections off the field are no obstacles or goals the robot can meet. Needs toField first.
+void removeOffField(const FieldCalibration& field, std::vector<Feature>* features);
 
 // Fills field_x_m / field_y_m from base_x_m / base_y_m for the pose of base_link in field.
 void toField(const Pose2D& pose, std::vector<Feature>* features);

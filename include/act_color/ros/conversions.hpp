@@ -4,6 +4,7 @@
 #include <sensor_msgs/Image.h>
 
 #include <string>
+#include <vector>
 
 #include "act_color/ColorLut.h"
 #include "act_color/core/act_trainer.hpp"
@@ -23,6 +24,9 @@ act_color::ColorLutPtr toMsg(const core::ActTrainer& trainer, const std_msgs::He
 
 // The table of a message; false with a reason when the message is inconsistent.
 bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* error);
+// The table and its clusters (for core::ActTrainer::restore); false with a reason.
+bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::vector<core::ActTrainer::SavedCluster>* clusters,
+             std::string* error);
 
 // Pose of base_link in field from a pose message; false with a reason for NaN/inf or a
 // non-planar orientation that cannot be reduced to a yaw.

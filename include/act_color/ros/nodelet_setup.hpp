@@ -9,14 +9,28 @@
 
 #include "act_color/core/calibration.hpp"
 
+// Runs `statement` (a log call) at most once per `period` seconds of wall time at this place:
+// rosconsole's *_THROTTLE runs on ROS time, so with a stopped /clock (a paused bag) it prints once
+// and then never, and after the clock jumps back it stays silent until the clock has caught up.
+//   ACT_WALL_THROTTLE(5.0, NODELET_WARN("image rejected: %s", why.c_str()));
+#define ACT_WALL_THROTTLE(period, ...)                                              \
+  do {                                                                              \
+    static double act_last_hit_s_ = -1e300;                                         \
+    const double act_now_s_ = ::ros::WallTime::now().toSec();                       \
+    if (act_now_s_ - act_last_hit_s_ >= (period) || act_now_s_ < act_last_hit_s_) { \
+      act_last_hit_s_ = act_now_s_;                                                 \
+      __VA_ARGS__;                                                                  \
+    }                                                                               \
+  } while (false)
+
 namespace act_color {
 namespace ros_conversions {
 
-// A nodelet's diagnostics: an updater (hardware id "act_color") with one task, updated every
-// second by *timer.
+// A nodelet's diagnostics: an updater (hardware id "act_color") with one task, published every
+// second of wall time by *timer, so that they go on while /clock stops or jumps back.
 std::unique_ptr<diagnostic_updater::Updater> makeDiagnostics(
     ros::NodeHandle& nh, ros::NodeHandle& pnh, const std::string& node_name, const std::string& task,
-    const std::function<void(diagnostic_updater::DiagnosticStatusWrapper&)>& diagnose, ros::Timer* timer);
+    const std::function<void(diagnostic_updater::DiagnosticStatusWrapper&)>& diagnose, ros::WallTimer* timer);
 
 // Runs a nodelet's configuration step; an exception is an error too. Empty when it succeeded,
 // else the reason. A nodelet that fails stays loaded and harmless: one that throws or exits takes
@@ -26,6 +40,32 @@ std::string runConfigure(const std::function<bool(std::string*)>& configure);
 // The calibration file named by ~calibration (its path in *path). False with the reason.
 bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,
                           std::string* error);
+
+// ~name in its real type: unchanged and true when it is not set; false with a reason naming the
+// parameter and its value as given when it has another type (`white_filter: 'false'`, `zeta: abc`:
+// rosparam's own getParam would fall back to the default silently). An integer is a double too.
+bool readParam(const ros::NodeHandle& nh, const std::string& name, double* value, std::string* error);
+bool readParam(const ros::NodeHandle& nh, const std::string& name, int* value, std::string* error);
+bool readParam(const ros::NodeHandle& nh, const std::string& name, bool* value, std::string* error);
+bool readParam(const ros::NodeHandle& nh, const std::string& name, std::string* value, std::string* error);
+
+// Notices a stamp going back by more than a second (a bag played again, `rosbag play -l`, a
+// restarted simulation): what depends on time must then start afresh.
+class TimeJumpDetector {
+ public:
+  static constexpr double kJumpBackS = 1.0;
+  // True when `stamp` is more than kJumpBackS before the latest stamp seen (it becomes the latest).
+  bool jumpedBack(const ros::Time& stamp) {
+    const bool jumped = !latest_.isZero() && stamp + ros::Duration(kJumpBackS) < latest_;
+    if (jumped || stamp > latest_) latest_ = stamp;
+    return jumped;
+  }
+  void reset() { latest_ = ros::Time(); }
+  const ros::Time& latest() const { return latest_; }
+
+ private:
+  ros::Time latest_;
+};
 
 }  // namespace ros_conversions
 }  // namespace act_color

@@ -16,8 +16,9 @@ namespace act_color {
 namespace ros_conversions {
 
 // The pose of base_link in field at an image's stamp, from the localization topic (the latest
-// pose at or before the stamp) or from tf (field -> base_link at the stamp, zero timeout). Never
-// blocks. Thread-safe.
+// pose at or before the stamp) or from tf (field -> base_link at the stamp). Never blocks: a caller
+// whose pose is not there yet asks mayStillCome() and tries again later (the trainer holds such an
+// image up to ~tf_timeout). Thread-safe.
 class PoseSource {
  public:
   enum class Mode { kTopic, kTf };
@@ -29,6 +30,15 @@ class PoseSource {
 
   // False with a reason (no pose yet, none before the stamp, too old, tf unavailable).
   bool lookup(const ros::Time& stamp, core::Pose2D* pose, std::string* why);
+  // After a failed lookup: true while the pose for `stamp` may still arrive (no pose or transform
+  // stamped at or after it has come yet).
+  bool mayStillCome(const ros::Time& stamp) const;
+  // After time jumped back: forgets the poses stamped after `stamp` (the old run's) and, in tf
+  // mode, tf's buffer when it holds such transforms.
+  void forgetNewerThan(const ros::Time& stamp);
+  void setMaxAge(double max_age_s);
+  // Times the pose stamps jumped back by more than a second (a new replay); reset() was called.
+  uint64_t timeJumps() const;
 
   Mode mode() const { return mode_; }
   // Poses received and rejected (NaN, non-planar) so far.
@@ -53,6 +63,8 @@ class PoseSource {
   std::deque<std::pair<ros::Time, core::Pose2D>> poses_;  // in arrival order
   uint64_t received_ = 0;
   uint64_t rejected_ = 0;
+  uint64_t time_jumps_ = 0;
+  ros::Time newest_stamp_;
   std::string last_rejection_;
 };
 
