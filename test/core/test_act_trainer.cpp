@@ -355,6 +355,43 @@ TEST_F(ActTrainerTest, SameSeedSameTable) {
   EXPECT_NE(a.lut().table(), c.lut().table());
 }
 
+// A saved state (table, clusters, revision) comes back as it was: training goes on from it, not
+// from eq. 2-3; a cluster that is none is refused.
+TEST_F(ActTrainerTest, ARestoredStateGoesOnWhereItStopped) {
+  const auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  ActTrainer a(cal);
+  a.bootstrap(view(frame.rgb), pose, 20);
+  std::vector<ActTrainer::SavedCluster> saved;
+  for (int k = 1; k < kNumClasses; ++k) saved.push_back({k, a.clusters()[k].mean(), a.clusters()[k].sigma()});
+  ActTrainer b(cal);
+  b.restore(a.lut(), saved, a.revision());
+  EXPECT_EQ(b.revision(), a.revision());
+  EXPECT_EQ(b.lut().table(), a.lut().table());
+  for (int k = 1; k < kNumClasses; ++k) {
+    const bool has_cells = a.lut().cellCounts()[k] > 0;
+    EXPECT_EQ(b.clusters()[k].trained(), has_cells) << k;
+    if (!has_cells) continue;
+    EXPECT_EQ(b.clusters()[k].mean(), a.clusters()[k].mean()) << k;
+    EXPECT_EQ(b.clusters()[k].sigma(), a.clusters()[k].sigma()) << k;
+  }
+  // The next cycle goes on from the saved clusters (its random start pixels differ: a's generator
+  // has moved on).
+  a.cycle(view(frame.rgb), pose);
+  b.cycle(view(frame.rgb), pose);
+  EXPECT_EQ(b.revision(), a.revision());
+  EXPECT_LT((b.clusters()[kGreen].mean() - a.clusters()[kGreen].mean()).norm(), 3.0);
+  EXPECT_LT(std::abs(b.clusters()[kGreen].sigma() - a.clusters()[kGreen].sigma()), 3.0);
+
+  for (const ActTrainer::SavedCluster& bad :
+       {ActTrainer::SavedCluster{7, Eigen::Vector3d(1, 2, 3), 5.0},
+        ActTrainer::SavedCluster{kGreen, Eigen::Vector3d(1, 2, std::nan("")), 5.0},
+        ActTrainer::SavedCluster{kGreen, Eigen::Vector3d(1, 2, 3), 0.0},
+        ActTrainer::SavedCluster{kGreen, Eigen::Vector3d(1, 300, 3), 5.0}}) {
+    ActTrainer c(cal);
+    EXPECT_THROW(c.restore(a.lut(), {bad}, 5), std::invalid_argument);
+  }
+}
+
 // The removal step reads packed rgb8 and bgr8 images by pixel index and other layouts by row and
 // column: the same picture gives the same table in every layout.
 TEST_F(ActTrainerTest, TheTableDoesNotDependOnTheImageLayout) {

@@ -23,28 +23,8 @@ namespace {
 
 namespace core = act_color::core;
 
-sensor_msgs::ImagePtr makeImage(const cv::Mat& mat, const std::string& encoding, const ros::Time& stamp) {
-  auto msg = boost::make_shared<sensor_msgs::Image>();
-  msg->header.stamp = stamp;
-  msg->header.frame_id = "omni_camera";
-  msg->height = mat.rows;
-  msg->width = mat.cols;
-  msg->encoding = encoding;
-  msg->step = static_cast<uint32_t>(mat.cols * mat.elemSize());
-  msg->data.assign(mat.datastart, mat.dataend);
-  return msg;
-}
-
-geometry_msgs::PoseWithCovarianceStamped makePose(const core::Pose2D& p, const ros::Time& stamp) {
-  geometry_msgs::PoseWithCovarianceStamped msg;
-  msg.header.stamp = stamp;
-  msg.header.frame_id = "field";
-  msg.pose.pose.position.x = p.x_m;
-  msg.pose.pose.position.y = p.y_m;
-  msg.pose.pose.orientation.z = std::sin(p.theta_rad / 2);
-  msg.pose.pose.orientation.w = std::cos(p.theta_rad / 2);
-  return msg;
-}
+using act_color_test::makeImage;
+using act_color_test::makePose;
 
 class BadInputs : public ::testing::Test {
  protected:

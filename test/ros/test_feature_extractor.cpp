@@ -126,4 +126,22 @@ TEST(FeatureExtractor, BallAndObstacleAtTheirFloorPoints) {
   EXPECT_THROW(core::extractFeatures(wrong, camera), std::invalid_argument);
 }
 
+// Features whose floor point lies beyond the carpet (hall clutter, people) are dropped; those on
+// it, including the goals' depth behind the goal lines, are kept.
+TEST(FeatureExtractor, OnlyFeaturesOnTheCarpetRemain) {
+  const core::Calibration cal = calibration();  // 18 x 12 m, margin 1 m, goals 0.5 m deep
+  std::vector<core::Feature> features(6);
+  const float at[6][2] = {{0.f, 0.f}, {9.9f, 6.9f}, {-9.5f, 0.f}, {10.1f, 0.f}, {0.f, -7.1f}, {NAN, 0.f}};
+  for (size_t i = 0; i < features.size(); ++i) {
+    features[i].field_x_m = at[i][0];
+    features[i].field_y_m = at[i][1];
+    features[i].size = static_cast<uint32_t>(i);
+  }
+  core::removeOffField(cal.field, &features);
+  ASSERT_EQ(features.size(), 3u);
+  EXPECT_EQ(features[0].size, 0u);
+  EXPECT_EQ(features[1].size, 1u);
+  EXPECT_EQ(features[2].size, 2u);
+}
+
 }  // namespace

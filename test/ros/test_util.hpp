@@ -1,13 +1,19 @@
 #pragma once
 
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <sensor_msgs/Image.h>
 
 #include <algorithm>
+#include <boost/make_shared.hpp>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
+#include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "act_color/core/metrics.hpp"
@@ -52,6 +58,31 @@ inline void expectPerClassAtLeast(const act_color::core::ClassificationMetrics& 
     EXPECT_GE(metrics.recall(k), min_recall[i]) << "recall of " << act_color::core::className(k);
     EXPECT_GE(metrics.precision(k), min_precision[i]) << "precision of " << act_color::core::className(k);
   }
+}
+
+// An image message holding a copy of `mat`.
+inline sensor_msgs::ImagePtr makeImage(const cv::Mat& mat, const std::string& encoding, const ros::Time& stamp) {
+  auto msg = boost::make_shared<sensor_msgs::Image>();
+  msg->header.stamp = stamp;
+  msg->header.frame_id = "omni_camera";
+  msg->height = mat.rows;
+  msg->width = mat.cols;
+  msg->encoding = encoding;
+  msg->step = static_cast<uint32_t>(mat.cols * mat.elemSize());
+  msg->data.assign(mat.datastart, mat.dataend);
+  return msg;
+}
+
+// A localization message (frame field) for a planar pose.
+inline geometry_msgs::PoseWithCovarianceStamped makePose(const act_color::core::Pose2D& p, const ros::Time& stamp) {
+  geometry_msgs::PoseWithCovarianceStamped msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = "field";
+  msg.pose.pose.position.x = p.x_m;
+  msg.pose.pose.position.y = p.y_m;
+  msg.pose.pose.orientation.z = std::sin(p.theta_rad / 2);
+  msg.pose.pose.orientation.w = std::cos(p.theta_rad / 2);
+  return msg;
 }
 
 }  // namespace act_color_test
