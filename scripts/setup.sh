@@ -19,7 +19,7 @@ ACT_DEB_PACKAGES=(
   rosout python3-rosbag librosbag-dev python3-rostopic python3-rosnode python3-rosparam
   rospack-tools libopencv-dev libeigen3-dev libgtest-dev rosbash python3-rosmsg
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
-  libdiagnostic-updater-dev ros-diagnostic-msgs libbenchmark-dev
+  libdiagnostic-updater-dev ros-diagnostic-msgs libbenchmark-dev libvisualization-msgs-dev ros-visualization-msgs catkin-lint
 )
 
 act_install_deps() {

@@ -9,6 +9,7 @@
 #include <nodelet/nodelet.h>
 #include <ros/ros.h>
 #include <std_msgs/UInt64MultiArray.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <boost/make_shared.hpp>
 #include <chrono>
@@ -27,6 +28,7 @@
 #include "act_color/FilePath.h"
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/lut_image.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/ros/checked_reconfigure.hpp"
 #include "act_color/ros/conversions.hpp"
@@ -65,6 +67,10 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   void publishOutputs(const core::ImageView& view, const sensor_msgs::ImageConstPtr& msg, bool have_pose,
                       const core::Pose2D& pose);
   void onTimeJump(const ros::Time& from, const ros::Time& to);
+  // The table as slices of its color cube (core::renderLutSlices), when someone listens.
+  void publishTableImage();
+  // The field model in rviz's 3-D view: line markings, carpet, goals (field frame, latched).
+  void publishFieldMarkers(const core::FieldModel& field);
   void record(Outcome outcome, double cycle_ms, double latency_ms);
   bool applyConfig(const ActTrainerConfig& config, std::string* error);
   ActTrainerConfig configInEffect() const;
@@ -81,12 +87,12 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::Subscriber image_sub_;
   image_transport::Publisher classified_pub_, expected_pub_;
-  ros::Publisher lut_pub_, lut_throttled_pub_, debug_pub_, ball_pub_, pose_pub_;
+  ros::Publisher lut_pub_, lut_throttled_pub_, debug_pub_, ball_pub_, pose_pub_, table_image_pub_, field_pub_;
   std::string base_frame_, field_frame_;
   ros::ServiceServer save_srv_, load_srv_;
   std::unique_ptr<ros_conversions::CheckedReconfigure<ActTrainerConfig>> reconfigure_;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
-  ros::WallTimer diagnostics_timer_, drain_timer_;
+  ros::WallTimer diagnostics_timer_, drain_timer_, table_image_timer_;
   ros_conversions::PoseSource pose_source_;
 
   // Everything below is guarded by mutex_.
@@ -110,6 +116,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   double lut_throttled_period_s_ = 1.0;
   ros::WallTime last_throttled_;
   uint64_t publishable_ = 0;  // images whose table could be published
+  uint64_t table_image_revision_ = 0;
+  std::string table_image_frame_;
   cv::Mat labels_, classified_, expected_;
   // Images waiting for their pose (pose and image of one instant come on two connections), in
   // order; at most kMaxPending.
@@ -294,13 +302,25 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // The ball on the carpet (ActParams::ball_training), in base_link, only when seen.
   ball_pub_ = nh_.advertise<geometry_msgs::PointStamped>("ball", 5);
   // The pose each frame was trained with, for rviz's 3-D view (field frame).
-  pose_pub_ = pnh_.advertise<geometry_msgs::PoseStamped>("pose", 2);
+  pose_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("trained_pose", 2);
   if (debug_addresses_) debug_pub_ = pnh_.advertise<std_msgs::UInt64MultiArray>("published_lut", 100);
   it_ = std::make_unique<image_transport::ImageTransport>(nh_);
   // Classified only while someone listens (checked per image); training needs every image anyway.
   classified_pub_ = it_->advertise("classified", 1);
   // The camera image with the classes the field model expects at the pose (what ACT trains with).
   expected_pub_ = it_->advertise("expected", 1);
+  // For people: the table as slices of its color cube (latched, at most once a second) and the
+  // field model in the 3-D view.
+  table_image_pub_ = nh_.advertise<sensor_msgs::Image>("table_image", 1, true);
+  table_image_timer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
+    try {
+      publishTableImage();
+    } catch (const std::exception& e) {
+      ACT_WALL_THROTTLE(5.0, NODELET_ERROR("table image: %s", e.what()));
+    }
+  });
+  field_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
+  publishFieldMarkers(core::FieldModel(calibration.field));
   save_srv_ = pnh_.advertiseService("save_lut", &ActTrainerNodelet::onSaveLut, this);
   load_srv_ = pnh_.advertiseService("load_lut", &ActTrainerNodelet::onLoadLut, this);
   reconfigure_ = std::make_unique<ros_conversions::CheckedReconfigure<ActTrainerConfig>>(
@@ -602,6 +622,86 @@ void ActTrainerNodelet::publishOutputs(const core::ImageView& view, const sensor
     cv::addWeighted(rgb, 0.5, expected_, 0.5, 0.0, out.image);
     expected_pub_.publish(out.toImageMsg());
   }
+}
+
+void ActTrainerNodelet::publishTableImage() {
+  if (table_image_pub_.getNumSubscribers() == 0) return;
+  cv_bridge::CvImage out;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!trainer_ || !has_table_ || trainer_->revision() == table_image_revision_) return;
+    table_image_revision_ = trainer_->revision();
+    const core::ColorLut& lut = trainer_->lut();
+    out.image = core::renderLutSlices(lut, std::min(16, 1 << lut.bitsPerChannel()),
+                                      std::string("ACT table, revision ") + std::to_string(trainer_->revision()));
+    out.header.stamp = image_time_.latest();
+  }
+  out.encoding = "bgr8";
+  table_image_pub_.publish(out.toImageMsg());
+}
+
+void ActTrainerNodelet::publishFieldMarkers(const core::FieldModel& field) {
+  visualization_msgs::MarkerArray markers;
+  visualization_msgs::Marker m;
+  m.header.frame_id = field_frame_;
+  m.ns = "field";
+  m.pose.orientation.w = 1.0;
+  m.action = visualization_msgs::Marker::ADD;
+  auto color = [](int k, double alpha) {
+    std_msgs::ColorRGBA c;
+    const auto& rgb = core::classPalette()[k];
+    c.r = rgb[0] / 255.f;
+    c.g = rgb[1] / 255.f;
+    c.b = rgb[2] / 255.f;
+    c.a = static_cast<float>(alpha);
+    return c;
+  };
+  // The carpet, the field plus its margin.
+  const core::FieldCalibration& f = field.calibration();
+  m.id = 0;
+  m.type = visualization_msgs::Marker::CUBE;
+  m.scale.x = f.length_m + 2 * f.margin_m;
+  m.scale.y = f.width_m + 2 * f.margin_m;
+  m.scale.z = 0.01;
+  m.pose.position.z = -0.01;
+  m.color = color(core::kGreen, 0.6);
+  markers.markers.push_back(m);
+  // The markings, sampled every 4 cm from the field model itself (arcs and lab-field variants
+  // included).
+  m.id = 1;
+  m.type = visualization_msgs::Marker::POINTS;
+  m.pose.position.z = 0.0;
+  m.scale.x = m.scale.y = 0.05;
+  m.color = color(core::kWhite, 1.0);
+  const double step = 0.04;
+  for (double x = -field.halfLength() - f.margin_m; x <= field.halfLength() + f.margin_m; x += step) {
+    for (double y = -field.halfWidth() - f.margin_m; y <= field.halfWidth() + f.margin_m; y += step) {
+      if (!field.isLine(x, y)) continue;
+      geometry_msgs::Point p;
+      p.x = x;
+      p.y = y;
+      m.points.push_back(p);
+    }
+  }
+  markers.markers.push_back(m);
+  m.points.clear();
+  // The goals as the boxes the expected-class model uses.
+  int id = 2;
+  for (core::ColorClass goal : {core::kYellow, core::kBlue}) {
+    Eigen::Vector3d lo, hi;
+    field.goalBox(goal, &lo, &hi);
+    m.id = id++;
+    m.type = visualization_msgs::Marker::CUBE;
+    m.pose.position.x = 0.5 * (lo.x() + hi.x());
+    m.pose.position.y = 0.5 * (lo.y() + hi.y());
+    m.pose.position.z = 0.5 * (lo.z() + hi.z());
+    m.scale.x = hi.x() - lo.x();
+    m.scale.y = hi.y() - lo.y();
+    m.scale.z = hi.z() - lo.z();
+    m.color = color(goal, 0.8);
+    markers.markers.push_back(m);
+  }
+  field_pub_.publish(markers);
 }
 
 bool ActTrainerNodelet::saveLut(const std::string& path, std::string* message) {

@@ -12,11 +12,7 @@
 // c2 R); CTable.dat for the image converted with cv::cvtColor(BGR2YUV) (c0 Y, c1 U, c2 V). Codes:
 // 0 ball ("yellow represent for football"), 1 black (obstacles), 2 green (field), 3 unknown; their
 // lines are found by brightness along scan lines, not by the table, and there are no goal classes.
-//
-// Image layout of `export` (tests rely on it): a header of kHeaderPx, then the maps in a grid of
-// `cols` columns (N <= 4: N; N <= 16: 4; else 8), each map under a label row of kLabelPx, maps
-// kPadPx apart and from the left edge, a legend row of kLegendPx at the bottom; width at least
-// kMinWidthPx. A slice map is 256 px square (cells of 256 / 2^bits px), the chroma map 512 px.
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -33,6 +29,7 @@
 
 #include "act_color/ColorLut.h"
 #include "act_color/core/color_lut.hpp"
+#include "act_color/core/lut_image.hpp"
 #include "act_color/core/types.hpp"
 #include "act_color/ros/conversions.hpp"
 #include "act_color/ros/lut_file.hpp"
@@ -182,12 +179,6 @@ Table loadTable(const std::string& path) {
 
 const char* spaceName(core::ColorSpace space) { return space == core::ColorSpace::kYuv ? "yuv" : "rgb"; }
 
-const char* channelName(core::ColorSpace space, int channel) {
-  static const char* const kRgb[3] = {"R", "G", "B"};
-  static const char* const kYuv[3] = {"Y", "U", "V"};
-  return (space == core::ColorSpace::kYuv ? kYuv : kRgb)[channel];
-}
-
 // ---------------------------------------------------------------------------------------------
 // info
 
@@ -197,8 +188,8 @@ int info(const std::string& path) {
   const core::ColorSpace space = lut.colorSpace();
   const int bits = lut.bitsPerChannel();
   std::printf("file: %s\n", path.c_str());
-  std::printf("color space: %s (channels %s, %s, %s)\n", spaceName(space), channelName(space, 0), channelName(space, 1),
-              channelName(space, 2));
+  std::printf("color space: %s (channels %s, %s, %s)\n", spaceName(space), core::channelName(space, 0),
+              core::channelName(space, 1), core::channelName(space, 2));
   std::printf("bits per channel: %d (%u^3 = %zu cells)\n", bits, 1u << bits, lut.size());
   std::printf("revision: %llu\n", static_cast<unsigned long long>(t.msg.revision));
   std::printf("stamp: %u.%09u%s%s%s\n", t.msg.header.stamp.sec, t.msg.header.stamp.nsec,
@@ -220,8 +211,8 @@ int info(const std::string& path) {
     std::printf("clusters: none (not saved by the trainer, e.g. imported)\n");
     return 0;
   }
-  std::printf("clusters: %zu (mean %s %s %s)\n", t.msg.clusters.size(), channelName(space, 0), channelName(space, 1),
-              channelName(space, 2));
+  std::printf("clusters: %zu (mean %s %s %s)\n", t.msg.clusters.size(), core::channelName(space, 0),
+              core::channelName(space, 1), core::channelName(space, 2));
   for (const act_color::ClassCluster& c : t.msg.clusters) {
     std::printf("  %-8s mean %6.1f %6.1f %6.1f  sigma %6.2f  samples %u  cells %u\n", core::className(c.class_id),
                 c.mean[0], c.mean[1], c.mean[2], c.sigma, c.samples, c.lut_cells);
@@ -232,150 +223,9 @@ int info(const std::string& path) {
 // ---------------------------------------------------------------------------------------------
 // export
 
-constexpr int kPadPx = 8;
-constexpr int kHeaderPx = 44;
-constexpr int kLabelPx = 18;
-constexpr int kLegendPx = 28;
-constexpr int kMinWidthPx = 820;
-constexpr int kSliceMapPx = 256;
-constexpr int kChromaMapPx = 512;
-const cv::Scalar kBackground(235, 235, 235);  // also chroma bins no color of the table falls in
-const cv::Scalar kUnknownColor(64, 64, 64);   // darker than the palette's grey: stands back
-const cv::Scalar kText(0, 0, 0);
-
-cv::Scalar classColor(int class_id) {
-  if (class_id <= core::kUnknown || class_id >= core::kNumClasses) return kUnknownColor;
-  const auto& rgb = core::classPalette()[class_id];
-  return cv::Scalar(rgb[2], rgb[1], rgb[0]);  // BGR, as cv::imwrite takes it
-}
-
-// The most frequent class other than unknown; unknown when there is none; ties to the lower id.
-int dominantClass(const uint32_t* counts) {
-  int best = core::kUnknown;
-  for (int k = 1; k < core::kNumClasses; ++k) {
-    if (counts[k] > 0 && (best == core::kUnknown || counts[k] > counts[best])) best = k;
-  }
-  return best;
-}
-
-// A canvas for `maps` square maps of `map_px`, with the header and the legend drawn.
-struct Canvas {
-  cv::Mat image;
-  int cols = 1;
-  int map_px = 0;
-  cv::Point origin(int k) const {
-    return cv::Point(kPadPx + (k % cols) * (map_px + kPadPx),
-                     kHeaderPx + (k / cols) * (kLabelPx + map_px + kPadPx) + kLabelPx);
-  }
-};
-
-void text(cv::Mat& image, const std::string& s, cv::Point at) {
-  cv::putText(image, s, at, cv::FONT_HERSHEY_SIMPLEX, 0.4, kText, 1, cv::LINE_AA);
-}
-
-Canvas makeCanvas(int maps, int map_px, const std::string& heading, const std::string& subtitle) {
-  Canvas c;
-  c.cols = maps <= 4 ? maps : (maps <= 16 ? 4 : 8);
-  c.map_px = map_px;
-  const int rows = (maps + c.cols - 1) / c.cols;
-  const int width = std::max(kMinWidthPx, kPadPx + c.cols * (map_px + kPadPx));
-  const int height = kHeaderPx + rows * (kLabelPx + map_px + kPadPx) + kLegendPx;
-  c.image = cv::Mat(height, width, CV_8UC3, kBackground);
-  text(c.image, heading, cv::Point(kPadPx, 17));
-  text(c.image, subtitle, cv::Point(kPadPx, 35));
-  const int legend_y = height - kLegendPx + 6;
-  for (int k = 0; k < core::kNumClasses; ++k) {
-    const int x = kPadPx + k * 110;
-    cv::rectangle(c.image, cv::Rect(x, legend_y, 14, 14), classColor(k), cv::FILLED);
-    cv::rectangle(c.image, cv::Rect(x, legend_y, 14, 14), cv::Scalar(160, 160, 160), 1);
-    text(c.image, core::className(k), cv::Point(x + 19, legend_y + 12));
-  }
-  return c;
-}
-
 std::string title(const std::string& path, const act_color::ColorLut& msg, const core::ColorLut& lut) {
   return baseName(path) + ": " + (lut.colorSpace() == core::ColorSpace::kYuv ? "YUV" : "RGB") + " table, " +
          std::to_string(lut.bitsPerChannel()) + " bits per channel, revision " + std::to_string(msg.revision);
-}
-
-cv::Mat renderSlices(const std::string& path, const Table& t, int slices) {
-  const core::ColorLut& lut = t.lut;
-  const core::ColorSpace space = lut.colorSpace();
-  const int bits = lut.bitsPerChannel();
-  const uint32_t n = 1u << bits;
-  const int cell_px = kSliceMapPx / static_cast<int>(n);
-  const int shift = 8 - bits;
-  const std::string c0 = channelName(space, 0), c1 = channelName(space, 1), c2 = channelName(space, 2);
-  Canvas canvas = makeCanvas(slices, kSliceMapPx, title(path, t.msg, lut),
-                             "slices along " + c0 + "; in each x = " + c1 + " 0-255 (right), y = " + c2 +
-                                 " 0-255 (up), the most frequent class of the slice, unknown dark grey");
-  uint32_t counts[core::kNumClasses];
-  for (int s = 0; s < slices; ++s) {
-    const uint32_t begin = s * n / slices, end = (s + 1) * n / slices;
-    const cv::Point o = canvas.origin(s);
-    text(canvas.image, c0 + " " + std::to_string(begin << shift) + "-" + std::to_string((end << shift) - 1),
-         cv::Point(o.x, o.y - 5));
-    for (uint32_t i1 = 0; i1 < n; ++i1) {
-      for (uint32_t i2 = 0; i2 < n; ++i2) {
-        std::fill(std::begin(counts), std::end(counts), 0u);
-        for (uint32_t i0 = begin; i0 < end; ++i0) {
-          const uint8_t k = lut.at(lut.cellIndex(i0, i1, i2));
-          if (k < core::kNumClasses) ++counts[k];
-        }
-        const cv::Rect r(o.x + static_cast<int>(i1) * cell_px, o.y + static_cast<int>(n - 1 - i2) * cell_px, cell_px,
-                         cell_px);
-        cv::rectangle(canvas.image, r, classColor(dominantClass(counts)), cv::FILLED);
-      }
-    }
-  }
-  return canvas.image;
-}
-
-// BT.601 full range, as core::rgbToUyvy converts.
-uint8_t clampByte(double x) { return static_cast<uint8_t>(std::min(255.0, std::max(0.0, std::round(x)))); }
-
-cv::Mat renderChroma(const std::string& path, const Table& t) {
-  const core::ColorLut& lut = t.lut;
-  const bool yuv = lut.colorSpace() == core::ColorSpace::kYuv;
-  const int bits = lut.bitsPerChannel();
-  const uint32_t n = 1u << bits;
-  const int cell_px = kChromaMapPx / static_cast<int>(n);
-  const int shift = 8 - bits;
-  const double half = shift > 0 ? 0.5 * (1 << shift) : 0.0;
-  Canvas canvas = makeCanvas(1, kChromaMapPx, title(path, t.msg, lut),
-                             "U-V map: x = U 0-255 (right), y = V 0-255 (up), the most frequent class over Y, unknown "
-                             "dark grey");
-  std::vector<uint32_t> counts(size_t{n} * n * core::kNumClasses, 0);
-  std::vector<uint8_t> seen(size_t{n} * n, 0);
-  for (uint32_t i0 = 0; i0 < n; ++i0) {
-    for (uint32_t i1 = 0; i1 < n; ++i1) {
-      for (uint32_t i2 = 0; i2 < n; ++i2) {
-        uint32_t u = i1, v = i2;
-        if (!yuv) {
-          const double r = (i0 << shift) + half, g = (i1 << shift) + half, b = (i2 << shift) + half;
-          u = clampByte(-0.168736 * r - 0.331264 * g + 0.5 * b + 128) >> shift;
-          v = clampByte(0.5 * r - 0.418688 * g - 0.081312 * b + 128) >> shift;
-        }
-        const size_t bin = size_t{u} * n + v;
-        seen[bin] = 1;
-        const uint8_t k = lut.at(lut.cellIndex(i0, i1, i2));
-        if (k < core::kNumClasses) ++counts[bin * core::kNumClasses + k];
-      }
-    }
-  }
-  const cv::Point o = canvas.origin(0);
-  text(canvas.image, yuv ? "U-V over all Y" : "RGB cells at their centres' BT.601 U, V; light grey: none",
-       cv::Point(o.x, o.y - 5));
-  for (uint32_t u = 0; u < n; ++u) {
-    for (uint32_t v = 0; v < n; ++v) {
-      const size_t bin = size_t{u} * n + v;
-      if (!seen[bin]) continue;
-      const cv::Rect r(o.x + static_cast<int>(u) * cell_px, o.y + static_cast<int>(n - 1 - v) * cell_px, cell_px,
-                       cell_px);
-      cv::rectangle(canvas.image, r, classColor(dominantClass(&counts[bin * core::kNumClasses])), cv::FILLED);
-    }
-  }
-  return canvas.image;
 }
 
 int exportImage(const std::string& path, const std::string& output, int slices, bool chroma) {
@@ -385,7 +235,8 @@ int exportImage(const std::string& path, const std::string& output, int slices, 
     throw std::invalid_argument("--slices " + std::to_string(slices) + ": the table has " + std::to_string(n) +
                                 " cells per channel");
   }
-  const cv::Mat image = chroma ? renderChroma(path, t) : renderSlices(path, t, slices);
+  const std::string heading = title(path, t.msg, t.lut);
+  const cv::Mat image = chroma ? core::renderLutChroma(t.lut, heading) : core::renderLutSlices(t.lut, slices, heading);
   bool written = false;
   try {
     written = cv::imwrite(output, image);
@@ -395,10 +246,10 @@ int exportImage(const std::string& path, const std::string& output, int slices, 
   if (!written) throw FileError("cannot write '" + output + "' (a .png path?)");
   if (chroma) {
     std::printf("wrote %s: %d x %d px, a U-V map, %d px per cell\n", output.c_str(), image.cols, image.rows,
-                kChromaMapPx / n);
+                core::kLutChromaMapPx / n);
   } else {
     std::printf("wrote %s: %d x %d px, %d slices along %s, %d px per cell\n", output.c_str(), image.cols, image.rows,
-                slices, channelName(t.lut.colorSpace(), 0), kSliceMapPx / n);
+                slices, core::channelName(t.lut.colorSpace(), 0), core::kLutSliceMapPx / n);
   }
   return 0;
 }
