@@ -50,6 +50,14 @@ class Operability : public ::testing::Test {
           for (const auto& s : m->status) status_[s.name] = s;
           waiter_.notify();
         });
+    agg_sub_ = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
+        "/diagnostics_agg", 10, [this](const diagnostic_msgs::DiagnosticArrayConstPtr& m) {
+          std::lock_guard<std::mutex> lock(waiter_.mutex());
+          size_t n = 0;
+          for (const auto& s : m->status) n += s.name.rfind("/ACT color", 0) == 0 ? 1 : 0;  // the group, its two
+          aggregated_ = n;
+          waiter_.notify();
+        });
     lut_sub_ = nh_.subscribe<act_color::ColorLut>("/act/color_lut", 50, [this](const act_color::ColorLutConstPtr& m) {
       std::lock_guard<std::mutex> lock(waiter_.mutex());
       luts_[m->header.stamp] = m;
@@ -117,7 +125,8 @@ class Operability : public ::testing::Test {
   const core::Pose2D pose_{-1.5, 1.0, 0.4};
   act_color::sim::LabeledFrame frame_;
   ros::Publisher image_pub_, pose_pub_;
-  ros::Subscriber log_sub_, diag_sub_, lut_sub_;
+  ros::Subscriber log_sub_, diag_sub_, agg_sub_, lut_sub_;
+  size_t aggregated_ = 0;
   act_color_test::Waiter waiter_;
   std::vector<rosgraph_msgs::LogConstPtr> logs_;
   std::map<std::string, diagnostic_msgs::DiagnosticStatus> status_;
@@ -237,7 +246,11 @@ TEST_F(Operability, DiagnosticsReconfigureSaveLoadTimeJump) {
     EXPECT_LT(latestTable()->revision, revision_before_jump + 50) << "not trained again from the start";
   }
 
-  // 7. No more images: both nodelets report their input stale.
+  // 7. The shipped aggregator config groups both nodelets under "ACT color".
+  EXPECT_TRUE(waiter_.waitFor(10.0, [&] { return aggregated_ >= 3; }))
+      << "statuses under /ACT color on /diagnostics_agg: " << aggregated_;
+
+  // 8. No more images: both nodelets report their input stale.
   EXPECT_TRUE(waiter_.waitFor(10.0,
                               [&] {
                                 return statusIs(trainer, DiagnosticStatus::WARN, "input stale") &&
