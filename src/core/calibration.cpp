@@ -1,13 +1,15 @@
 #include "act_color/core/calibration.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <regex>
 #include <set>
 #include <sstream>
+
+#include "act_color/core/yaml_subset.hpp"
 
 namespace act_color {
 namespace core {
@@ -17,47 +19,50 @@ namespace {
   throw CalibrationError(source + ": " + key + ": " + what);
 }
 
-// Reads one YAML map, remembering which keys were read so that the rest can be rejected.
+// Reads one YAML map, remembering which keys were read so that the rest can be rejected. Values
+// are typed here, in their real type: an integer is read as int64 and range-checked before it
+// becomes an int (no wrap), a number is decimal (no octal, no hex, no inf).
 class MapReader {
  public:
-  MapReader(const cv::FileNode& node, std::string path, const std::string& source)
+  MapReader(const YamlNode* node, std::string path, const std::string& source)
       : node_(node), path_(std::move(path)), source_(source) {
-    if (node_.empty() || node_.isNone()) fail(source_, path_, "missing");
-    if (!node_.isMap()) fail(source_, path_, "must be a map");
+    if (node_ == nullptr) fail(source_, path_, "missing");
+    if (!node_->isMap()) fail(source_, path_, "must be a map" + at(*node_));
     std::set<std::string> seen;
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      const std::string name = (*it).name();
-      if (!seen.insert(name).second) fail(source_, key(name), "appears twice");
+    for (const auto& e : node_->entries) {
+      if (!seen.insert(e.first).second) fail(source_, key(e.first), "appears twice" + at(e.second));
     }
   }
 
   std::string key(const std::string& name) const { return path_.empty() ? name : path_ + "." + name; }
+  static std::string at(const YamlNode& n) {
+    return " (line " + std::to_string(n.line) + ", column " + std::to_string(n.column) + ")";
+  }
 
-  cv::FileNode child(const std::string& name) {
+  const YamlNode& child(const std::string& name) {
     used_.insert(name);
-    cv::FileNode n = node_[name];
-    if (n.empty() || n.isNone()) fail(source_, key(name), "missing");
-    return n;
+    const YamlNode* n = node_->find(name);
+    if (n == nullptr) fail(source_, key(name), "missing");
+    return *n;
   }
-  bool has(const std::string& name) const {
-    cv::FileNode n = node_[name];
-    return !(n.empty() || n.isNone());
-  }
+  bool has(const std::string& name) const { return node_->find(name) != nullptr; }
 
-  double number(const cv::FileNode& n, const std::string& k) const {
-    if (!(n.isReal() || n.isInt())) fail(source_, k, "must be a number");
-    const double value = static_cast<double>(n);
-    if (!std::isfinite(value)) fail(source_, k, "must be finite");
+  double number(const YamlNode& n, const std::string& k) const {
+    double value = 0;
+    if (!n.isScalar() || n.quoted || !parseYamlNumber(n.scalar, &value)) {
+      fail(source_, k, "must be a finite decimal number, is " + describe(n) + at(n));
+    }
     return value;
   }
 
   // A number in [lo, hi] (open at lo when lo_open).
   double real(const std::string& name, double lo, double hi, bool lo_open = false) {
     const std::string k = key(name);
-    const double value = number(child(name), k);
+    const YamlNode& n = child(name);
+    const double value = number(n, k);
     if ((lo_open ? value <= lo : value < lo) || value > hi) {
       std::ostringstream s;
-      s << "must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], is " << value;
+      s << "must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], is " << n.scalar << at(n);
       fail(source_, k, s.str());
     }
     return value;
@@ -65,53 +70,65 @@ class MapReader {
 
   int integer(const std::string& name, int lo, int hi) {
     const std::string k = key(name);
-    cv::FileNode n = child(name);
-    if (!n.isInt()) fail(source_, k, "must be an integer");
-    const int value = static_cast<int>(n);
-    if (value < lo || value > hi) {
-      fail(source_, k,
-           "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], is " + std::to_string(value));
+    const YamlNode& n = child(name);
+    long long value = 0;
+    if (!n.isScalar() || n.quoted || !parseYamlInteger(n.scalar, &value)) {
+      fail(source_, k, "must be an integer (decimal, no leading zero), is " + describe(n) + at(n));
     }
-    return value;
+    if (value < lo || value > hi) {
+      fail(source_, k, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], is " + n.scalar + at(n));
+    }
+    return static_cast<int>(value);
   }
 
   int sign(const std::string& name) {
     const std::string k = key(name);
-    cv::FileNode n = child(name);
-    if (!n.isInt() || (static_cast<int>(n) != 1 && static_cast<int>(n) != -1)) fail(source_, k, "must be 1 or -1");
-    return static_cast<int>(n);
+    const YamlNode& n = child(name);
+    long long value = 0;
+    if (!n.isScalar() || n.quoted || !parseYamlInteger(n.scalar, &value) || (value != 1 && value != -1)) {
+      fail(source_, k, "must be 1 or -1, is " + describe(n) + at(n));
+    }
+    return static_cast<int>(value);
   }
 
-  MapReader map(const std::string& name) { return MapReader(child(name), key(name), source_); }
+  MapReader map(const std::string& name) { return MapReader(&child(name), key(name), source_); }
 
   void rejectUnknownKeys() const {
-    for (auto it = node_.begin(); it != node_.end(); ++it) {
-      const std::string name = (*it).name();
-      if (!used_.count(name)) fail(source_, key(name), "unknown key");
+    for (const auto& e : node_->entries) {
+      if (!used_.count(e.first)) fail(source_, key(e.first), "unknown key" + at(e.second));
     }
   }
 
   const std::string& source() const { return source_; }
 
+  // What a node is, for messages: its text, shortened, or "a list" / "a map".
+  static std::string describe(const YamlNode& n) {
+    if (n.isList()) return "a list";
+    if (n.isMap()) return "a map";
+    std::string text = n.scalar.size() > 40 ? n.scalar.substr(0, 40) + "..." : n.scalar;
+    return n.quoted ? "the string \"" + text + "\"" : "'" + text + "'";
+  }
+
  private:
-  cv::FileNode node_;
+  const YamlNode* node_;
   std::string path_;
   std::string source_;
   std::set<std::string> used_;
 };
 
-std::vector<double> numberSequence(MapReader& reader, const cv::FileNode& n, const std::string& k, size_t size) {
-  if (!n.isSeq() || n.size() != size)
-    fail(reader.source(), k, "must be a list of " + std::to_string(size) + " numbers");
+std::vector<double> numberSequence(MapReader& reader, const YamlNode& n, const std::string& k, size_t size) {
+  if (!n.isList() || n.items.size() != size) {
+    fail(reader.source(), k, "must be a list of " + std::to_string(size) + " numbers" + MapReader::at(n));
+  }
   std::vector<double> values;
-  for (size_t i = 0; i < size; ++i) values.push_back(reader.number(n[static_cast<int>(i)], k));
+  for (size_t i = 0; i < size; ++i) values.push_back(reader.number(n.items[i], k));
   return values;
 }
 
 CameraCalibration parseCamera(MapReader camera) {
   CameraCalibration c;
-  c.width = camera.integer("width", 16, 16384);
-  c.height = camera.integer("height", 16, 16384);
+  c.width = camera.integer("width", 16, kMaxImageSidePx);
+  c.height = camera.integer("height", 16, kMaxImageSidePx);
   const auto center = numberSequence(camera, camera.child("center"), camera.key("center"), 2);
   c.center_u = center[0];
   c.center_v = center[1];
@@ -120,21 +137,22 @@ CameraCalibration parseCamera(MapReader camera) {
   c.height_m = camera.real("height_m", 0.0, 10.0, true);
   c.chassis_radius_px = camera.real("chassis_radius_px", 0.0, 1e5);
   c.mirror_radius_px = camera.real("mirror_radius_px", 0.0, 1e5, true);
-  const cv::FileNode map = camera.child("elevation_map");
+  const YamlNode& map = camera.child("elevation_map");
   const std::string map_key = camera.key("elevation_map");
-  if (!map.isSeq() || map.size() < 2)
-    fail(camera.source(), map_key, "must be a list of at least two [r_px, elevation_rad] pairs");
-  for (size_t i = 0; i < map.size(); ++i) {
+  if (!map.isList() || map.items.size() < 2) {
+    fail(camera.source(), map_key, "must be a list of at least two [r_px, elevation_rad] pairs" + MapReader::at(map));
+  }
+  c.elevation_map.reserve(map.items.size());
+  for (size_t i = 0; i < map.items.size(); ++i) {
     const std::string entry_key = map_key + "[" + std::to_string(i) + "]";
-    const auto pair = numberSequence(camera, map[static_cast<int>(i)], entry_key, 2);
+    const auto pair = numberSequence(camera, map.items[i], entry_key, 2);
     c.elevation_map.emplace_back(pair[0], pair[1]);
   }
   if (camera.has("self_mask")) {
-    const cv::FileNode n = camera.child("self_mask");
-    if (!n.isString() || static_cast<std::string>(n).empty() ||
-        static_cast<std::string>(n).find_first_of("\"\\\n") != std::string::npos)
+    const YamlNode& n = camera.child("self_mask");
+    if (!n.isScalar() || n.scalar.empty() || n.scalar.find_first_of("\"\\\n") != std::string::npos)
       fail(camera.source(), camera.key("self_mask"), "must be the file name of a PNG (no quotes or backslashes)");
-    c.self_mask_file = static_cast<std::string>(n);
+    c.self_mask_file = n.scalar;
   }
   camera.rejectUnknownKeys();
   return c;
@@ -199,29 +217,17 @@ FieldCalibration parseField(MapReader field) {
   return f;
 }
 
-std::string fixParserLine(const std::string& message) {
-  // We prepend one line ("%YAML:1.0") for OpenCV's parser; report the file's own line numbers.
-  std::smatch m;
-  static const std::regex kLine("\\((\\d+)\\)");
-  if (std::regex_search(message, m, kLine)) {
-    const int line = std::stoi(m[1]) - 1;
-    return m.prefix().str() + "(line " + std::to_string(line) + ")" + m.suffix().str();
-  }
-  return message;
-}
-
 }  // namespace
 
 Calibration parseCalibration(const std::string& yaml_text, const std::string& source_name) {
-  cv::FileStorage storage;
+  YamlNode root_node;
   try {
-    storage.open("%YAML:1.0\n" + yaml_text,
-                 cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    throw CalibrationError(source_name + ": not valid YAML: " + fixParserLine(e.err));
+    root_node = parseYaml(yaml_text);
+  } catch (const YamlError& e) {
+    throw CalibrationError(source_name + ": not valid YAML: " + e.what());
   }
-  if (!storage.isOpened()) throw CalibrationError(source_name + ": not valid YAML");
-  MapReader root(storage.root(), "", source_name);
+  if (root_node.isScalar() && root_node.scalar.empty()) throw CalibrationError(source_name + ": not valid YAML: empty");
+  MapReader root(&root_node, "", source_name);
   Calibration calibration;
   calibration.camera = parseCamera(root.map("camera"));
   calibration.field = parseField(root.map("field"));
@@ -232,16 +238,35 @@ Calibration parseCalibration(const std::string& yaml_text, const std::string& so
 }
 
 Calibration loadCalibration(const std::string& path) {
-  std::ifstream file(path);
+  // A regular file of bounded size only: a FIFO or a device would block or never end.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw CalibrationError(path + ": cannot be read (no such file)");
+  if (!std::filesystem::is_regular_file(status)) throw CalibrationError(path + ": is not a regular file");
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  const YamlLimits limits;
+  if (ec) throw CalibrationError(path + ": cannot be read");
+  if (size > limits.max_bytes) {
+    throw CalibrationError(path + ": " + std::to_string(size) + " bytes, more than the " +
+                           std::to_string(limits.max_bytes) + " a calibration file may have");
+  }
+  std::ifstream file(path, std::ios::binary);
   if (!file) throw CalibrationError(path + ": cannot be read");
-  std::stringstream text;
-  text << file.rdbuf();
-  return parseCalibration(text.str(), path);
+  std::string text(static_cast<size_t>(size), '\0');
+  file.read(&text[0], static_cast<std::streamsize>(size));
+  text.resize(static_cast<size_t>(file.gcount()));
+  return parseCalibration(text, path);
 }
 
 void validateCalibration(const Calibration& calibration, const std::string& source) {
   const CameraCalibration& c = calibration.camera;
   if (c.width < 16 || c.height < 16) fail(source, "camera.width", "image must be at least 16x16 px");
+  if (c.width > kMaxImageSidePx || c.height > kMaxImageSidePx ||
+      static_cast<int64_t>(c.width) * c.height > kMaxImagePixels) {
+    fail(source, "camera.width",
+         std::to_string(c.width) + "x" + std::to_string(c.height) + " px is larger than " +
+             std::to_string(kMaxImagePixels) + " pixels or " + std::to_string(kMaxImageSidePx) + " px a side (limit)");
+  }
   if (!(c.center_u >= 0 && c.center_u <= c.width && c.center_v >= 0 && c.center_v <= c.height)) {
     fail(source, "camera.center", "must lie inside the image");
   }
@@ -260,6 +285,30 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
     if (i > 0 && !(e > c.elevation_map[i - 1].second)) fail(source, key, "elevation_rad must increase strictly");
   }
   if (!(c.elevation_map.front().second < 0)) fail(source, "camera.elevation_map[0]", "must look below the horizon");
+  {
+    // Some pixel of the image must see the floor: a radius between the chassis and the mirror's
+    // rim, inside the image, covered by the map and below the horizon.
+    const double far_u = std::max(c.center_u, c.width - c.center_u),
+                 far_v = std::max(c.center_v, c.height - c.center_v);
+    const double lo = std::max(c.elevation_map.front().first, c.chassis_radius_px);
+    const double hi = std::min({c.elevation_map.back().first, c.mirror_radius_px, std::hypot(far_u, far_v)});
+    if (!(lo < hi)) {
+      std::ostringstream s;
+      s << "images no pixel: it covers r " << c.elevation_map.front().first << " to " << c.elevation_map.back().first
+        << " px, the image has r up to " << std::hypot(far_u, far_v) << " px between the chassis ("
+        << c.chassis_radius_px << ") and the mirror's rim (" << c.mirror_radius_px << ")";
+      fail(source, "camera.elevation_map", s.str());
+    }
+    // Elevation grows with r: the innermost imaged radius looks lowest.
+    const auto& map = c.elevation_map;
+    size_t k = 1;
+    while (k + 1 < map.size() && map[k].first < lo) ++k;
+    const double t = (lo - map[k - 1].first) / (map[k].first - map[k - 1].first);
+    const double lowest = map[k - 1].second + std::clamp(t, 0.0, 1.0) * (map[k].second - map[k - 1].second);
+    if (!(lowest < 0)) {
+      fail(source, "camera.elevation_map", "no imaged pixel looks below the horizon: the camera would see no floor");
+    }
+  }
 
   const FieldCalibration& f = calibration.field;
   if (!(2 * f.line_width_m < std::min(f.length_m, f.width_m)))

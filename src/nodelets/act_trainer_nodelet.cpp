@@ -341,7 +341,9 @@ bool ActTrainerNodelet::configure(std::string* error) {
 
   // Training needs every image, whether or not anyone listens to the outputs.
   const image_transport::TransportHints hints("raw", ros::TransportHints(), pnh_);
-  image_sub_ = it_->subscribe("image", 2, &ActTrainerNodelet::onImage, this, hints);
+  // A few frames of slack (as the segmentation): a slow cycle, or a busy machine replaying a bag,
+  // does not drop frames at once.
+  image_sub_ = it_->subscribe("image", 5, &ActTrainerNodelet::onImage, this, hints);
   NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s", calibration_path.c_str(),
                calibration.camera.width, calibration.camera.height,
                pose_source_.mode() == ros_conversions::PoseSource::Mode::kTf ? "tf" : "topic",

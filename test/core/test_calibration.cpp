@@ -110,9 +110,9 @@ TEST(Calibration, ValuesAreRangeChecked) {
   EXPECT_NE(errorOf(replaced(contractText(), "chassis_radius_px: 42", "chassis_radius_px: 300"))
                 .find("camera.chassis_radius_px"),
             std::string::npos);
-  EXPECT_NE(
-      errorOf(replaced(contractText(), "length_m: 18.0", "length_m: abc")).find("field.length_m: must be a number"),
-      std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "length_m: 18.0", "length_m: abc"))
+                .find("field.length_m: must be a finite decimal number"),
+            std::string::npos);
   EXPECT_NE(errorOf(replaced(contractText(), "goal: {width_m: 2.0", "goal: {width_m: 20.0")).find("field.goal.width_m"),
             std::string::npos);
 }
@@ -179,11 +179,79 @@ TEST(Calibration, LabFieldKeysAreChecked) {
             std::string::npos);
   EXPECT_NE(arc("{radius_m: 0, center_distance_m: 2.25}").find("field.penalty_arc.radius_m"), std::string::npos);
   // An arc that stays inside the penalty area (2.25 m deep) would never be drawn.
-  EXPECT_NE(arc("{radius_m: 0.5, center_distance_m: 3.0}").find("reach out of the penalty area"),
-            std::string::npos);
+  EXPECT_NE(arc("{radius_m: 0.5, center_distance_m: 3.0}").find("reach out of the penalty area"), std::string::npos);
   EXPECT_NE(errorOf(replaced(text, "depth_m: 0.5}", "depth_m: 0.5, setback_m: 1.5}")).find("field.goal.setback_m"),
             std::string::npos);  // beyond the 1 m margin
   EXPECT_NE(errorOf(replaced(text, "corner_arc_radius_m: 0.75", "corner_arc_radius_m: -0.1"))
                 .find("field.corner_arc_radius_m"),
             std::string::npos);
+}
+
+// Issue 15: hostile calibration files are refused with a message, in bounded time and memory.
+TEST(Calibration, NestingSizeAndSyntaxAreBoundedAndLocated) {
+  // 40,000 levels of nesting (80 KB): refused at the limit, no stack overflow.
+  std::string deep = "camera: " + std::string(40000, '[') + std::string(40000, ']') + "\n";
+  EXPECT_NE(errorOf(deep).find("nested deeper than 16 levels"), std::string::npos) << errorOf(deep);
+  std::string deep_block;
+  for (int i = 0; i < 2000; ++i) deep_block += std::string(static_cast<size_t>(i), ' ') + "k:\n";
+  EXPECT_NE(errorOf(deep_block).find("nested deeper"), std::string::npos) << errorOf(deep_block).substr(0, 200);
+  // More than 4 MiB: refused before parsing.
+  EXPECT_NE(errorOf(contractText() + "# " + std::string(5u << 20, 'x') + "\n").find("bytes, more than"),
+            std::string::npos);
+  // Syntax errors say where.
+  const std::string bad = replaced(contractText(), "  height_m: 0.75", "  height_m: [0.75");
+  EXPECT_NE(errorOf(bad).find("unclosed '['"), std::string::npos) << errorOf(bad);
+  EXPECT_NE(errorOf("camera:\n  width: 1\n   height: 2\n").find("line 3, column 4: unexpected indentation"),
+            std::string::npos)
+      << errorOf("camera:\n  width: 1\n   height: 2\n");
+  EXPECT_NE(errorOf("camera: &a {x: 1}\nfield: *a\n").find("anchors, aliases"), std::string::npos);
+  EXPECT_NE(errorOf("camera:\n\twidth: 1\n").find("line 2, column 1: a tab"), std::string::npos);
+}
+
+TEST(Calibration, ValuesAreReadInTheirRealType) {
+  // No 32-bit wrap: 2^32 + 1 is not 1.
+  EXPECT_NE(
+      errorOf(replaced(contractText(), "height_m: 0.75", "height_m: 4294967297")).find("camera.height_m: must be in"),
+      std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "bearing_sign: 1", "bearing_sign: 4294967295"))
+                .find("camera.bearing_sign: must be 1 or -1, is '4294967295'"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "width: 580", "width: 99999999999999999999999"))
+                .find("camera.width: must be an integer"),
+            std::string::npos);
+  // No octal: 0580 is refused, not read as something else.
+  EXPECT_NE(errorOf(replaced(contractText(), "width: 580", "width: 0580")).find("camera.width: must be an integer"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "height_m: 0.75", "height_m: 0x1")).find("camera.height_m"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "height_m: 0.75", "height_m: .inf")).find("camera.height_m"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(contractText(), "height_m: 0.75", "height_m: \"0.75\"")).find("the string \"0.75\""),
+            std::string::npos);
+  // Flow and block styles, comments and quoted keys read alike.
+  const std::string flow =
+      replaced(contractText(), "  center: [290.0, 290.0]", "  \"center\": [290.0,\n     290.0]  # c");
+  EXPECT_EQ(errorOf(flow), "");
+}
+
+TEST(Calibration, AnImageTooLargeOrAMapThatImagesNothingIsRefused) {
+  EXPECT_NE(errorOf(replaced(replaced(contractText(), "width: 580", "width: 16384"), "height: 580", "height: 16384"))
+                .find("camera.width: must be in [16, 8192]"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replaced(replaced(contractText(), "width: 580", "width: 8000"), "height: 580", "height: 8000"))
+                .find("larger than 16777216 pixels"),
+            std::string::npos);
+  // An elevation map beyond the image's corners: no pixel would see anything.
+  std::string far = replaced(contractText(), "[42.0, -1.45]", "[1000.0, -1.45]");
+  far = replaced(far, "[286.0, 0.20]", "[2000.0, 0.20]");
+  EXPECT_NE(errorOf(far).find("images no pixel"), std::string::npos) << errorOf(far);
+}
+
+TEST(Calibration, OnlyRegularFilesAreRead) {
+  try {
+    act_color::core::loadCalibration("/dev/zero");
+    FAIL() << "no error";
+  } catch (const CalibrationError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+  }
 }

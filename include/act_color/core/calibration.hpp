@@ -11,6 +11,11 @@ namespace act_color {
 namespace core {
 
 // The camera-to-world mapping of the contract's calibration file.
+// Largest camera image a calibration may describe (the per-pixel tables of the camera model are
+// built for every pixel): 8192 px a side, 16 Mpx in all.
+constexpr int kMaxImageSidePx = 8192;
+constexpr int64_t kMaxImagePixels = int64_t{4096} * 4096;
+
 struct CameraCalibration {
   int width = 0;
   int height = 0;
