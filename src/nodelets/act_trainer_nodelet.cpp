@@ -7,12 +7,15 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <std_msgs/UInt64MultiArray.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <boost/make_shared.hpp>
 #include <chrono>
+#include <condition_variable>
+#include <cstdlib>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -22,6 +25,7 @@
 #include <pluginlib/class_list_macros.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "act_color/ActTrainerConfig.h"
 #include "act_color/ColorLut.h"
@@ -90,6 +94,10 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   ros::Publisher lut_pub_, lut_throttled_pub_, debug_pub_, ball_pub_, pose_pub_, table_image_pub_, field_pub_;
   std::string base_frame_, field_frame_;
   ros::ServiceServer save_srv_, load_srv_;
+  // The services' file I/O runs on a queue and thread of its own: a slow or stuck file system never
+  // holds up training (the image callbacks' queue).
+  ros::CallbackQueue io_queue_;
+  std::unique_ptr<ros::AsyncSpinner> io_spinner_;
   std::unique_ptr<ros_conversions::CheckedReconfigure<ActTrainerConfig>> reconfigure_;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   ros::WallTimer diagnostics_timer_, drain_timer_, table_image_timer_;
@@ -107,6 +115,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool bootstrap_at_first_pose_ = false;
   bool has_table_ = false;  // bootstrapped, loaded or trained at least once
   std::string lut_file_;
+  std::string lut_dir_;                             // saves only inside it
+  std::optional<core::PixelFormat> camera_format_;  // of the last usable image
   bool save_on_shutdown_ = false;
   bool reset_on_time_jump_ = false;
   bool debug_addresses_ = false;
@@ -138,6 +148,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
 };
 
 ActTrainerNodelet::~ActTrainerNodelet() {
+  // No service call may run into a half-destroyed nodelet.
+  if (io_spinner_) io_spinner_->stop();
   // ~save_on_shutdown: the table of this run survives the robot's restart. Never throws.
   try {
     std::string path, message;
@@ -233,11 +245,11 @@ bool ActTrainerNodelet::configure(std::string* error) {
   bool bootstrap_at_first_pose = false, save_on_shutdown = false, reset_on_time_jump = false, debug = false;
   double tf_timeout = tf_timeout_s_, throttled_period = lut_throttled_period_s_, max_pose_age = max_pose_age_s_;
   int publish_every = publish_lut_every_;
-  std::string lut_file, load_path, base_frame = "base_link", field_frame = "field";
+  std::string lut_file, load_path, lut_dir, base_frame = "base_link", field_frame = "field";
   if (!readParam(pnh_, "bootstrap_cycles", &bootstrap_cycles, error) ||
       !readParam(pnh_, "bootstrap_at_first_pose", &bootstrap_at_first_pose, error) ||
       !readParam(pnh_, "lut_file", &lut_file, error) || !readParam(pnh_, "load_lut", &load_path, error) ||
-      !readParam(pnh_, "save_on_shutdown", &save_on_shutdown, error) ||
+      !readParam(pnh_, "lut_dir", &lut_dir, error) || !readParam(pnh_, "save_on_shutdown", &save_on_shutdown, error) ||
       !readParam(pnh_, "reset_on_time_jump", &reset_on_time_jump, error) ||
       !readParam(pnh_, "tf_timeout", &tf_timeout, error) || !readParam(pnh_, "max_pose_age", &max_pose_age, error) ||
       !readParam(pnh_, "publish_lut_every", &publish_every, error) ||
@@ -255,6 +267,12 @@ bool ActTrainerNodelet::configure(std::string* error) {
     *error = "parameter ~bootstrap_cycles must be in [1, 1000], is " + std::to_string(bootstrap_cycles);
     return false;
   }
+  if (lut_dir.empty()) {
+    // $ROS_HOME/act_color, as ROS puts its own files.
+    const char* ros_home = std::getenv("ROS_HOME");
+    const char* home = std::getenv("HOME");
+    lut_dir = ros_home ? std::string(ros_home) + "/act_color" : std::string(home ? home : "/tmp") + "/.ros/act_color";
+  }
   if (save_on_shutdown && lut_file.empty()) {
     *error = "~save_on_shutdown needs ~lut_file (the file to save to)";
     return false;
@@ -269,6 +287,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
     bootstrap_cycles_ = bootstrap_cycles;
     bootstrap_at_first_pose_ = bootstrap_at_first_pose;
     lut_file_ = lut_file;
+    lut_dir_ = lut_dir;
     save_on_shutdown_ = save_on_shutdown;
     reset_on_time_jump_ = reset_on_time_jump;
     debug_addresses_ = debug;
@@ -321,8 +340,14 @@ bool ActTrainerNodelet::configure(std::string* error) {
   });
   field_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
   publishFieldMarkers(core::FieldModel(calibration.field));
-  save_srv_ = pnh_.advertiseService("save_lut", &ActTrainerNodelet::onSaveLut, this);
-  load_srv_ = pnh_.advertiseService("load_lut", &ActTrainerNodelet::onLoadLut, this);
+  {
+    ros::NodeHandle io(pnh_);
+    io.setCallbackQueue(&io_queue_);
+    save_srv_ = io.advertiseService("save_lut", &ActTrainerNodelet::onSaveLut, this);
+    load_srv_ = io.advertiseService("load_lut", &ActTrainerNodelet::onLoadLut, this);
+    io_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &io_queue_);
+    io_spinner_->start();
+  }
   reconfigure_ = std::make_unique<ros_conversions::CheckedReconfigure<ActTrainerConfig>>(
       pnh_, configInEffect(), [this](const ActTrainerConfig& c, std::string* e) { return applyConfig(c, e); },
       [this](const std::string& e) {
@@ -514,6 +539,11 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
     record(Outcome::kRejected, 0.0, -1.0);
     return true;
   }
+  if (has_table_ && trainer_->lut().colorSpace() != core::nativeColorSpace(view.format)) {
+    NODELET_ERROR("the color table is %s but the camera sends %s: the table starts afresh",
+                  trainer_->lut().colorSpace() == core::ColorSpace::kYuv ? "YUV" : "RGB", msg->encoding.c_str());
+  }
+  camera_format_ = view.format;
 
   core::Pose2D pose;
   std::string why;
@@ -706,10 +736,12 @@ void ActTrainerNodelet::publishFieldMarkers(const core::FieldModel& field) {
   field_pub_.publish(markers);
 }
 
-bool ActTrainerNodelet::saveLut(const std::string& path, std::string* message) {
+bool ActTrainerNodelet::saveLut(const std::string& requested, std::string* message) {
   act_color::ColorLutPtr msg;
+  std::string path;
   {
     std::lock_guard<std::mutex> lock(mutex_);
+    if (!ros_conversions::lutPathInside(lut_dir_, requested, &path, message)) return false;
     if (!trainer_ || !has_table_) {
       *message = trainer_ ? "no table trained yet" : "the nodelet is not configured: " + config_error_;
       return false;
@@ -727,10 +759,15 @@ bool ActTrainerNodelet::saveLut(const std::string& path, std::string* message) {
   return true;
 }
 
-bool ActTrainerNodelet::loadLut(const std::string& path, std::string* message) {
+bool ActTrainerNodelet::loadLut(const std::string& requested, std::string* message) {
   act_color::ColorLut msg;
   core::ColorLut lut;
   std::vector<core::ActTrainer::SavedCluster> clusters;
+  std::string path = requested;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!path.empty() && path[0] != '/') path = lut_dir_ + "/" + path;  // relative: in ~lut_dir
+  }
   if (!ros_conversions::loadLutFile(path, &msg, message)) return false;
   if (!ros_conversions::fromMsg(msg, &lut, &clusters, message)) {
     *message = path + ": " + *message;
@@ -739,6 +776,11 @@ bool ActTrainerNodelet::loadLut(const std::string& path, std::string* message) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!trainer_) {
     *message = "the nodelet is not configured: " + config_error_;
+    return false;
+  }
+  if (camera_format_ && lut.colorSpace() != core::nativeColorSpace(*camera_format_)) {
+    *message = path + ": the table is " + (lut.colorSpace() == core::ColorSpace::kYuv ? "YUV" : "RGB") +
+               ", the camera sends " + core::encodingName(*camera_format_) + ": not loaded";
     return false;
   }
   try {
@@ -762,10 +804,50 @@ bool ActTrainerNodelet::requestPath(const FilePath::Request& req, FilePath::Resp
   return false;
 }
 
+namespace {
+
+// Runs `io` on a thread of its own and waits at most `timeout_s`: a file system that hangs (a dead
+// network mount) leaves the service answering, the I/O thread going on alone.
+bool withTimeout(const std::function<bool(std::string*)>& io, double timeout_s, std::string* message) {
+  struct Shared {
+    std::mutex mutex;
+    std::condition_variable done_cv;
+    bool done = false, ok = false;
+    std::string message;
+  };
+  auto shared = std::make_shared<Shared>();
+  std::thread([shared, io] {
+    std::string m;
+    bool ok = false;
+    try {
+      ok = io(&m);
+    } catch (const std::exception& e) {
+      m = e.what();
+    }
+    std::lock_guard<std::mutex> lock(shared->mutex);
+    shared->ok = ok;
+    shared->message = m;
+    shared->done = true;
+    shared->done_cv.notify_all();
+  }).detach();
+  std::unique_lock<std::mutex> lock(shared->mutex);
+  if (!shared->done_cv.wait_for(lock, std::chrono::duration<double>(timeout_s), [&] { return shared->done; })) {
+    *message = "the file operation did not finish within " + std::to_string(static_cast<int>(timeout_s)) +
+               " s (a hanging file system?); it goes on in the background";
+    return false;
+  }
+  *message = shared->message;
+  return shared->ok;
+}
+
+constexpr double kFileTimeoutS = 5.0;
+
+}  // namespace
+
 bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& res) {
   std::string path;
   if (!requestPath(req, res, &path)) return true;
-  res.success = saveLut(path, &res.message);
+  res.success = withTimeout([this, path](std::string* m) { return saveLut(path, m); }, kFileTimeoutS, &res.message);
   if (!res.success) NODELET_ERROR("~save_lut: %s", res.message.c_str());
   return true;
 }
@@ -773,7 +855,7 @@ bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& re
 bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& res) {
   std::string path;
   if (!requestPath(req, res, &path)) return true;
-  res.success = loadLut(path, &res.message);
+  res.success = withTimeout([this, path](std::string* m) { return loadLut(path, m); }, kFileTimeoutS, &res.message);
   if (!res.success) NODELET_ERROR("~load_lut: %s", res.message.c_str());
   return true;
 }

@@ -9,8 +9,11 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/Image.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -35,6 +38,7 @@ class Operability : public ::testing::Test {
     model_ =
         std::make_unique<core::ExpectedClassModel>(core::loadCalibration(pnh.param<std::string>("calibration", "")));
     lut_file_ = pnh.param<std::string>("lut_file", "");
+    lut_dir_ = pnh.param<std::string>("lut_dir", "");
     std::remove(lut_file_.c_str());
     image_pub_ = nh_.advertise<sensor_msgs::Image>("/omni/image_raw", 50);
     pose_pub_ = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("/localization/pose", 50);
@@ -121,7 +125,7 @@ class Operability : public ::testing::Test {
   ros::NodeHandle nh_;
   ros::AsyncSpinner spinner_{2};
   std::unique_ptr<core::ExpectedClassModel> model_;
-  std::string lut_file_;
+  std::string lut_file_, lut_dir_;
   const core::Pose2D pose_{-1.5, 1.0, 0.4};
   act_color::sim::LabeledFrame frame_;
   ros::Publisher image_pub_, pose_pub_;
@@ -227,6 +231,38 @@ TEST_F(Operability, DiagnosticsReconfigureSaveLoadTimeJump) {
       for (int i = 0; i < 3; ++i) EXPECT_NEAR(after->clusters[k].mean[i], before_save->clusters[k].mean[i], 10.0) << k;
       EXPECT_LT(after->clusters[k].sigma, 100.0) << k;
     }
+  }
+
+  // 5b. Saves stay inside ~lut_dir and never overwrite an unrelated file; loads read regular files.
+  {
+    auto call = [](const std::string& service, const std::string& path) {
+      act_color::FilePath srv;
+      srv.request.path = path;
+      EXPECT_TRUE(ros::service::call(service, srv));
+      return srv.response;
+    };
+    const std::string unrelated = lut_dir_ + "/notes.lut";
+    { std::ofstream(unrelated) << "team notes\n"; }
+    for (const std::string& bad : {std::string("../escape.lut"), std::string("/etc/act_color.lut"),
+                                   std::string("sub/../../escape.lut"), unrelated}) {
+      const auto r = call("/act_trainer/save_lut", bad);
+      EXPECT_FALSE(r.success) << bad;
+      std::printf("save_lut %s: %s\n", bad.c_str(), r.message.c_str());
+    }
+    std::ifstream in(unrelated);
+    std::string text;
+    std::getline(in, text);
+    EXPECT_EQ(text, "team notes") << "an unrelated file was overwritten";
+    EXPECT_FALSE(std::ifstream("/tmp/escape.lut").good());
+    const auto inside = call("/act_trainer/save_lut", "second.lut");
+    EXPECT_TRUE(inside.success) << inside.message;
+    const std::string fifo = lut_dir_ + "/fifo.lut";
+    ::unlink(fifo.c_str());
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const auto from_fifo = call("/act_trainer/load_lut", fifo);
+    EXPECT_FALSE(from_fifo.success);
+    EXPECT_NE(from_fifo.message.find("not a regular file"), std::string::npos) << from_fifo.message;
+    ::unlink(fifo.c_str());
   }
 
   // 6. Time jumps back 100 s (a bag played again): logged once per nodelet, the table kept.

@@ -1,62 +1,35 @@
 #pragma once
 
-#include <ros/serialization.h>
-
-#include <fstream>
-#include <iterator>
+#include <cstddef>
 #include <string>
-#include <vector>
 
 #include "act_color/ColorLut.h"
 
 namespace act_color {
 namespace ros_conversions {
 
-// A ColorLut message (table and clusters) in a file: the message's ROS serialization after a
-// magic line, so that a file is self-describing and needs no other format.
+// A ColorLut message (table, clusters, revision) in a file: the message's ROS serialization after
+// a magic line, so that a file is self-describing and needs no other format.
 constexpr char kLutFileMagic[] = "act_color/ColorLut v1\n";
+// The largest such file: an 8-bit table (16 Mi cells), its clusters and a short frame id.
+constexpr size_t kMaxLutFileBytes = (size_t{1} << 24) + 4096;
 
-inline bool saveLutFile(const act_color::ColorLut& msg, const std::string& path, std::string* error) {
-  const uint32_t size = ::ros::serialization::serializationLength(msg);
-  std::vector<uint8_t> buffer(size);
-  ::ros::serialization::OStream stream(buffer.data(), size);
-  ::ros::serialization::serialize(stream, msg);
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) {
-    *error = "cannot open '" + path + "' for writing";
-    return false;
-  }
-  out << kLutFileMagic;
-  out.write(reinterpret_cast<const char*>(buffer.data()), static_cast<std::streamsize>(buffer.size()));
-  if (!out.good()) {
-    *error = "cannot write '" + path + "'";
-    return false;
-  }
-  return true;
-}
+// Writes atomically: to a temporary file beside `path`, then renamed over it, so that a crash or a
+// full disk never leaves half a table. An existing `path` is replaced only when it is a regular
+// file that already holds a color table (never truncates an unrelated file). False with a reason.
+bool saveLutFile(const act_color::ColorLut& msg, const std::string& path, std::string* error);
 
-inline bool loadLutFile(const std::string& path, act_color::ColorLut* msg, std::string* error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    *error = "cannot open '" + path + "'";
-    return false;
-  }
-  std::string magic(sizeof(kLutFileMagic) - 1, '\0');
-  in.read(&magic[0], static_cast<std::streamsize>(magic.size()));
-  if (!in || magic != kLutFileMagic) {
-    *error = "'" + path + "' is not a color table file (saved by ~save_lut)";
-    return false;
-  }
-  std::vector<uint8_t> buffer((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  try {
-    ::ros::serialization::IStream stream(buffer.data(), static_cast<uint32_t>(buffer.size()));
-    ::ros::serialization::deserialize(stream, *msg);
-  } catch (const std::exception& e) {
-    *error = "'" + path + "' is truncated or corrupt: " + e.what();
-    return false;
-  }
-  return true;
-}
+// Reads a file written by saveLutFile: a regular file of at most kMaxLutFileBytes, whose every
+// length field is checked against the bytes there before anything is allocated for it (a forged
+// length cannot make it allocate gigabytes). False with a reason ("cannot open", "is not a color
+// table file", "truncated or corrupt: ...", "table has N cells, expected M", ...). Table contents
+// (class ids, clusters) are checked by fromMsg.
+bool loadLutFile(const std::string& path, act_color::ColorLut* msg, std::string* error);
+
+// The file a ~save_lut request may write: `requested` relative to `dir` (or absolute), which must
+// lie inside `dir` once `..` and symbolic links are resolved; no NUL bytes, not a directory.
+// Creates `dir` when missing. False with a reason.
+bool lutPathInside(const std::string& dir, const std::string& requested, std::string* resolved, std::string* error);
 
 }  // namespace ros_conversions
 }  // namespace act_color
