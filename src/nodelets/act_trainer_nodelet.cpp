@@ -278,6 +278,9 @@ bool ActTrainerNodelet::configure(std::string* error) {
     return false;
   }
   if (!pose_source_.init(nh_, pnh_, getName(), error)) return false;
+  // A pose off the carpet by more than a metre is a localization failure, not a place to train at.
+  pose_source_.setFieldBounds(0.5 * calibration.field.length_m + calibration.field.margin_m + 1.0,
+                              0.5 * calibration.field.width_m + calibration.field.margin_m + 1.0);
 
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -1,10 +1,26 @@
 #include "act_color/ros/nodelet_setup.hpp"
 
 #include <exception>
+#include <map>
+#include <mutex>
 #include <sstream>
 
 namespace act_color {
 namespace ros_conversions {
+
+bool wallThrottle(const std::string& key, double period_s) {
+  static std::mutex mutex;
+  static std::map<std::string, double> last;
+  const double now = ros::WallTime::now().toSec();
+  std::lock_guard<std::mutex> lock(mutex);
+  if (last.size() > 1000) last.clear();  // keys are kinds of messages; never grows without bound
+  auto it = last.find(key);
+  if (it != last.end() && now - it->second < period_s && now >= it->second) return false;
+  last[key] = now;
+  return true;
+}
+
+std::string keyOf(const std::string& message) { return message.substr(0, message.find_first_of("0123456789(")); }
 
 std::unique_ptr<diagnostic_updater::Updater> makeDiagnostics(
     ros::NodeHandle& nh, ros::NodeHandle& pnh, const std::string& node_name, const std::string& task,

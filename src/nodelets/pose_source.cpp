@@ -46,10 +46,10 @@ void PoseSource::onPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& 
   std::string error;
   std::lock_guard<std::mutex> lock(mutex_);
   ++received_;
-  if (!pose2D(msg->pose.pose, &pose, &error)) {
+  if (!pose2D(msg->pose.pose, &pose, &error) || !plausible(pose, &error)) {
     ++rejected_;
     last_rejection_ = "pose stamped " + std::to_string(msg->header.stamp.toSec()) + " rejected: " + error;
-    ACT_WALL_THROTTLE(5.0, ROS_ERROR("%s: %s", name_.c_str(), last_rejection_.c_str()));
+    if (wallThrottle(name_ + keyOf(error), 5.0)) ROS_ERROR("%s: %s", name_.c_str(), last_rejection_.c_str());
     return;
   }
   if (!msg->header.frame_id.empty() && msg->header.frame_id != field_frame_ &&
@@ -82,7 +82,7 @@ bool PoseSource::lookup(const ros::Time& stamp, core::Pose2D* pose, std::string*
       p.position.y = t.transform.translation.y;
       p.position.z = t.transform.translation.z;
       p.orientation = t.transform.rotation;
-      return pose2D(p, pose, why);
+      return pose2D(p, pose, why) && plausible(*pose, why);
     } catch (const std::exception& e) {
       *why = std::string("no tf ") + field_frame_ + " -> " + base_frame_ + " at the image stamp: " + e.what();
       return false;
@@ -143,6 +143,21 @@ void PoseSource::forgetNewerThan(const ros::Time& stamp) {
       // nothing there to forget
     }
   }
+}
+
+void PoseSource::setFieldBounds(double half_x_m, double half_y_m) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  half_x_m_ = half_x_m;
+  half_y_m_ = half_y_m;
+}
+
+bool PoseSource::plausible(const core::Pose2D& pose, std::string* why) const {
+  if (std::abs(pose.x_m) <= half_x_m_ && std::abs(pose.y_m) <= half_y_m_) return true;
+  std::ostringstream s;
+  s << "pose (" << pose.x_m << ", " << pose.y_m << ") m is off the field (|x| <= " << half_x_m_
+    << ", |y| <= " << half_y_m_ << " m with the margin)";
+  *why = s.str();
+  return false;
 }
 
 void PoseSource::setMaxAge(double max_age_s) {

@@ -2,6 +2,7 @@
 
 #include <boost/make_shared.hpp>
 #include <cmath>
+#include <sstream>
 
 namespace act_color {
 namespace ros_conversions {
@@ -111,12 +112,23 @@ bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* err
     return false;
   }
   const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-  if (norm < 1e-6) {
-    *error = "pose orientation is a zero quaternion";
+  if (std::abs(norm - 1.0) > kMaxQuaternionNormError) {
+    std::ostringstream s;
+    s << "pose orientation is not a unit quaternion (norm " << norm << ")";
+    *error = s.str();
     return false;
   }
-  // Yaw of a planar pose; a robot on the floor does not roll or pitch noticeably.
   const double x = q.x / norm, y = q.y / norm, z = q.z / norm, w = q.w / norm;
+  // A robot on the floor: its z axis stays within a few degrees of the vertical (the cosine of
+  // the tilt is the z-z entry of the rotation matrix).
+  const double cos_tilt = 1.0 - 2.0 * (x * x + y * y);
+  if (cos_tilt < std::cos(kMaxTiltRad)) {
+    std::ostringstream s;
+    s << "pose is tilted by " << std::acos(std::max(-1.0, std::min(1.0, cos_tilt))) * 180.0 / M_PI
+      << " degrees (roll/pitch), a robot on the floor is not";
+    *error = s.str();
+    return false;
+  }
   out->x_m = p.x;
   out->y_m = p.y;
   out->theta_rad = std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));

@@ -115,16 +115,28 @@ TEST_F(BadInputs, ThrottledErrorsNoCrashStillWorking) {
   cv::Mat small(100, 100, CV_8UC3, cv::Scalar(30, 120, 30));
   core::Pose2D nan_pose = pose;
   nan_pose.x_m = std::numeric_limits<double>::quiet_NaN();
+  // 5. Implausible poses (issue 15): 50 m off the field, rolled 90 degrees.
+  const core::Pose2D far_pose{50.0, 0.0, 0.0};
+  geometry_msgs::PoseWithCovarianceStamped rolled = makePose(pose, ros::Time::now());
+  rolled.pose.pose.orientation.x = std::sqrt(0.5);
+  rolled.pose.pose.orientation.y = 0.0;
+  rolled.pose.pose.orientation.z = 0.0;
+  rolled.pose.pose.orientation.w = std::sqrt(0.5);
   for (int i = 0; i < kRepeats; ++i) {
     image_pub_.publish(makeImage(mono, "mono8", ros::Time::now()));
     image_pub_.publish(makeImage(small, "rgb8", ros::Time::now()));
     pose_pub_.publish(makePose(nan_pose, ros::Time::now()));
+    pose_pub_.publish(makePose(far_pose, ros::Time::now()));
+    rolled.header.stamp = ros::Time::now();
+    pose_pub_.publish(rolled);
   }
   EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "unsupported encoding 'mono8'"));
   EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "image is 100x100 px"));
   EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "NaN"));
+  EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "is off the field"));
+  EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "tilted by 90"));
 
-  // 5. Still alive and working: a good pose and image are trained and segmented. Pose and image
+  // 6. Still alive and working: a good pose and image are trained and segmented. Pose and image
   // come on different connections, so the image may overtake its pose: then the trainer holds it
   // until the next image (README, act_trainer) and its table comes one frame later. Good frames
   // are sent until a table stamped with any of them has come.

@@ -26,6 +26,12 @@
 namespace act_color {
 namespace ros_conversions {
 
+// A wall-time throttle per key (thread-safe): true at most once per `period_s` for each key, so
+// that one kind of bad input does not hide another. Keys are kinds of messages, e.g. a message's
+// text up to its first number (keyOf).
+bool wallThrottle(const std::string& key, double period_s);
+std::string keyOf(const std::string& message);
+
 // A nodelet's diagnostics: an updater (hardware id "act_color") with one task, published every
 // second of wall time by *timer, so that they go on while /clock stops or jumps back.
 std::unique_ptr<diagnostic_updater::Updater> makeDiagnostics(

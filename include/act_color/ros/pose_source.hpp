@@ -37,6 +37,8 @@ class PoseSource {
   // mode, tf's buffer when it holds such transforms.
   void forgetNewerThan(const ros::Time& stamp);
   void setMaxAge(double max_age_s);
+  // Poses beyond |x| <= half_x_m, |y| <= half_y_m (the carpet plus a margin) are rejected.
+  void setFieldBounds(double half_x_m, double half_y_m);
   // Times the pose stamps jumped back by more than a second (a new replay); reset() was called.
   uint64_t timeJumps() const;
 
@@ -53,6 +55,9 @@ class PoseSource {
   Mode mode_ = Mode::kTopic;
   std::string name_;
   double max_age_s_ = 1.0;
+  double half_x_m_ = 1e9, half_y_m_ = 1e9;
+  // False with a reason for a pose off the field.
+  bool plausible(const core::Pose2D& pose, std::string* why) const;
   std::string field_frame_ = "field";
   std::string base_frame_ = "base_link";
   ros::Subscriber sub_;
