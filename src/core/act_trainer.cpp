@@ -222,6 +222,7 @@ void ActTrainer::reset(ColorSpace space) {
   evidence_.assign(lut_.size(), Evidence{});
   for (auto& cluster : clusters_) cluster.reset(255.0);
   light_.reset();
+  light_states_.clear();
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
   space_known_ = true;
@@ -258,6 +259,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   neighbour_only_.assign(lut_.size(), 0);
   evidence_.assign(lut_.size(), Evidence{});
   light_.reset();
+  light_states_.clear();
   space_known_ = true;
 }
 
@@ -414,7 +416,7 @@ bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t curre
   return (other.mean() - color).norm() / other.sigma() <= (own.mean() - color).norm() / own.sigma();
 }
 
-void ActTrainer::applyLightChange(const LightModel::Map& map) {
+void ActTrainer::applyLightChange(const LightModel::Map& map, bool keep_rest) {
   const ClusterParams cluster_params = clusterParams();
   for (auto& cluster : clusters_) {
     const double scale = std::clamp(map.maxSlope(cluster.mean(), cluster.sigma()), 0.1, 10.0);
@@ -429,7 +431,11 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
   const int bits = lut_.bitsPerChannel();
   const int cells = 1 << bits;
   const double width = 1 << (8 - bits);
-  warped_.assign(lut_.table().begin(), lut_.table().end());
+  if (keep_rest) {
+    warped_.assign(lut_.table().begin(), lut_.table().end());
+  } else {
+    warped_.assign(lut_.size(), kUnknown);
+  }
   warped_neighbour_only_.assign(neighbour_only_.begin(), neighbour_only_.end());
   warped_evidence_.assign(evidence_.begin(), evidence_.end());
   const uint32_t mask = (1u << bits) - 1;
@@ -469,6 +475,53 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
   // field must not be protected from removal.
   std::fill(confirmed_.begin(), confirmed_.end(), 0u);
   ball_hypotheses_.clear();  // their colors are the old light's
+}
+
+bool ActTrainer::restoreLightState() {
+  // States older than the evidence's memory describe a light too long ago to trust.
+  light_states_.erase(std::remove_if(light_states_.begin(), light_states_.end(),
+                                     [&](const LightState& s) { return revision_ - s.left_at > kEvidenceMemory; }),
+                      light_states_.end());
+  const Eigen::Vector3d now = light_.greenMedian();
+  LightState* best = nullptr;
+  double best_distance = 0;
+  for (LightState& s : light_states_) {
+    if (!s.light.hasReference()) continue;
+    const double distance = (s.light.referenceGreenMedian() - now).norm();
+    const double tolerance = std::max(kLightChangeSigmas * s.clusters[kGreen].sigma(), kLightChangeMinShift);
+    if (distance <= tolerance && (best == nullptr || distance < best_distance)) {
+      best = &s;
+      best_distance = distance;
+    }
+  }
+  if (best == nullptr) return false;
+  // Swap: the light left takes the restored one's place.
+  LightModel observed = light_;  // this cycle's anchors
+  std::swap(lut_, best->lut);
+  neighbour_only_.swap(best->neighbour_only);
+  evidence_.swap(best->evidence);
+  confirmed_.swap(best->confirmed);
+  std::swap(clusters_, best->clusters);
+  std::swap(light_, best->light);
+  best->light = observed;  // the light left: its reference
+  best->left_at = revision_;
+  light_.adoptObservation(observed);  // the light restored: its reference, this cycle's anchors
+  rebuildMapped();
+  ball_hypotheses_.clear();
+  return true;
+}
+
+void ActTrainer::keepLightState() {
+  LightState s;
+  s.lut = lut_;
+  s.neighbour_only = neighbour_only_;
+  s.evidence = evidence_;
+  s.confirmed = confirmed_;
+  s.clusters = clusters_;
+  s.light = light_;
+  s.left_at = revision_;
+  if (light_states_.size() >= kMaxLightStates) light_states_.erase(light_states_.begin());
+  light_states_.push_back(std::move(s));
 }
 
 void ActTrainer::setCell(uint32_t cell, uint8_t k) {
@@ -605,16 +658,26 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       anchor_samples_[k].emplace_back(c[0], c[1], c[2]);
     });
     light_.observe(anchor_samples_[kGreen], anchor_samples_[kWhite], chassis_samples_);
-    light_changed = light_.observedGreen() && lightMoved() && light_.estimate(lut_.colorSpace(), &light_map);
+    light_changed = light_.observedGreen() && lightMoved();
+  }
+  if (light_changed && restoreLightState()) {
+    light_changed = false;
+    stats.light_restored = true;
+  } else if (light_changed) {
+    light_changed = light_.estimate(lut_.colorSpace(), &light_map);
   }
   if (light_changed) {
+    // A light within the memory of another: the old light's cells are kept with its state, so the
+    // moved table holds only the moved cells (moving the union to and fro spreads the classes).
+    const bool keep_rest = light_states_.empty();
+    keepLightState();
     const Eigen::Vector3d from = light_.referenceGreenMedian();
     const Eigen::Vector3d pivot = LightModel::pivot(lut_.colorSpace());
     for (int c = 0; c < 3; ++c) {
       const double d = from[c] - pivot[c];
       stats.light_gain[c] = static_cast<float>(std::abs(d) > 1e-6 ? (light_map.at(c, from[c]) - pivot[c]) / d : 1.0);
     }
-    applyLightChange(light_map);
+    applyLightChange(light_map, keep_rest);
     light_.rebase(light_map);
     stats.light_change = true;
   } else if (params_.light_compensation) {

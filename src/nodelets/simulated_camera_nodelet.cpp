@@ -19,6 +19,7 @@
 #include "act_color/core/calibration.hpp"
 #include "act_color/sim/renderer.hpp"
 #include "act_color/sim/scenario.hpp"
+#include "act_color/sim/tone_curve.hpp"
 
 namespace act_color {
 
@@ -42,6 +43,10 @@ class SimulatedCameraNodelet : public nodelet::Nodelet {
   bool loop_ = true;
   int max_frames_ = 0;
   double light_amplitude_ = 0.3;
+  // Flicker (issue 15): from frame flicker_start_ on, the last frame of every flicker_period_
+  // frames is darkened to flicker_gain_ (2: every other frame; 10: one dark frame in ten); 0: none.
+  int flicker_period_ = 0, flicker_start_ = 0;
+  double flicker_gain_ = 0.5;
   double light_period_s_ = 20.0;
   double start_delay_s_ = 0.0;
   int wait_image_subscribers_ = 0, wait_truth_subscribers_ = 0;
@@ -69,6 +74,12 @@ void SimulatedCameraNodelet::onInit() {
     max_frames_ = pnh.param("max_frames", 0);
     light_amplitude_ = pnh.param("light_amplitude", 0.3);
     light_period_s_ = pnh.param("light_period", 20.0);
+    flicker_period_ = pnh.param("flicker_period", 0);
+    flicker_start_ = pnh.param("flicker_start", 0);
+    flicker_gain_ = pnh.param("flicker_gain", 0.5);
+    if (flicker_period_ < 0 || flicker_period_ == 1 || flicker_start_ < 0 ||
+        !(flicker_gain_ > 0.0 && flicker_gain_ <= 4.0))
+      throw std::invalid_argument("~flicker_period must be 0 or >= 2, ~flicker_start >= 0, ~flicker_gain in (0, 4]");
     start_delay_s_ = pnh.param("start_delay", 0.0);
     wait_image_subscribers_ = pnh.param("wait_for_image_subscribers", 0);
     wait_truth_subscribers_ = pnh.param("wait_for_truth_subscribers", 0);
@@ -134,6 +145,11 @@ void SimulatedCameraNodelet::run() {
       // Light changing over time on top of the scenario's own.
       const double t = (ros::WallTime::now() - t0).toSec();
       frame.scene.lighting.level *= 1.0 + light_amplitude_ * std::sin(2.0 * M_PI * t / light_period_s_);
+      if (flicker_period_ > 0 && published >= flicker_start_ &&
+          (published - flicker_start_) % flicker_period_ == flicker_period_ - 1) {
+        frame.scene.lighting.transfer =
+            frame.scene.lighting.transfer.then(sim::ToneCurve::gain(Eigen::Vector3d::Constant(flicker_gain_)));
+      }
       // The first pass is the scenario as act_make_scenarios writes it; later passes get new noise.
       frame.scene.noise_seed += loops * 1000003u;
       const sim::LabeledFrame rendered = renderer.render(frame.scene);

@@ -104,6 +104,7 @@ struct CycleStats {
   bool color_space_changed = false;                     // table reset for a new color space
   bool light_change = false;                            // light compensation applied
   Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain at the carpet's color
+  bool light_restored = false;                          // a change back to a light seen before: its table restored
   bool ball_seeded = false;                             // the ball's cluster was (re)seeded
   // The ball as seen in this image (ActParams::ball_training), under the table before 2.4.
   struct Ball {
@@ -179,7 +180,14 @@ class ActTrainer {
   // ActParams::evidence_removal_ratio for class k (lower for the ball).
   double evidenceRatio(uint8_t k) const;
   // Light compensation: the map moves every cluster and every table cell.
-  void applyLightChange(const LightModel::Map& map);
+  void applyLightChange(const LightModel::Map& map, bool keep_rest);
+  // Light that comes and goes (flicker, an exposure controller hunting, one dark frame in ten):
+  // the state of each light recently left is kept, and a change back to one of them restores its
+  // table, clusters and evidence instead of moving the table once more. Moving it to and fro would
+  // spread every class a cell further with each round (the table filled to 98% under flicker).
+  // Returns true when it restored one (the state left is kept in its place).
+  bool restoreLightState();
+  void keepLightState();
   // The ball stage (ActParams::ball_training), after 2.3; needs sector_safe_range_ of the pose.
   void trainBall(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
 
@@ -229,6 +237,17 @@ class ActTrainer {
   std::vector<uint8_t> warped_neighbour_only_;
   std::vector<Evidence> evidence_;
   std::vector<Evidence> warped_evidence_;
+  struct LightState {
+    ColorLut lut;
+    std::vector<uint8_t> neighbour_only;
+    std::vector<Evidence> evidence;
+    std::vector<uint32_t> confirmed;
+    std::array<ClassCluster, kNumClasses> clusters;
+    LightModel light;
+    uint64_t left_at = 0;  // revision when this light was left
+  };
+  static constexpr size_t kMaxLightStates = 6;
+  std::vector<LightState> light_states_;  // the most recently left last
   // One bit per table cell: mapped to a class (32 KB for 6 bits per channel).
   std::vector<uint64_t> mapped_;
   int add_weight_ = 1;  // pixels one in-field sample stands for in this cycle

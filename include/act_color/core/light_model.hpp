@@ -50,6 +50,8 @@ class LightModel {
   void follow(double eta);
   // After a change: the reference becomes this cycle's anchors; anchors not seen are mapped.
   void rebase(const Map& map);
+  // This cycle's anchors from another model (which observed this cycle's image); the reference stays.
+  void adoptObservation(const LightModel& other) { current_ = other.current_; }
   void reset();
 
  private:
