@@ -5,11 +5,13 @@
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
+#include <algorithm>
 #include <map>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
+#include "act_color/ColorLut.h"
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/metrics.hpp"
 #include "act_color/sim/scenario.hpp"
@@ -38,6 +40,14 @@ TEST(Pipeline, SimulatedScenarioAccuracy) {
       act_color::sim::makeScenario(scenario_name, act_color::sim::ScenarioLength::kSmall, cal, 1);
   // Frames right after a change of light are adaptation (paper, 3.2: 12 cycles), as in issue 3's test.
   std::vector<bool> steady(scenario.frames.size(), true);
+  // Flicker (simulated_camera ~flicker_*): the dark frames are not the steady light.
+  const int flicker_period = pnh.param("flicker_period", 0), flicker_start = pnh.param("flicker_start", 0);
+  const double max_fill_ratio = pnh.param("max_fill_ratio", 0.0);
+  auto isDark = [&](size_t i) {
+    return flicker_period > 0 && static_cast<int>(i) >= flicker_start &&
+           (static_cast<int>(i) - flicker_start) % flicker_period == flicker_period - 1;
+  };
+  for (size_t i = 0; i < steady.size(); ++i) steady[i] = steady[i] && !isDark(i);
   steady[0] = false;  // the bootstrap frame
   for (size_t i = 0; i < scenario.frames.size(); ++i) {
     for (const std::string& e : scenario.frames[i].events) {
@@ -64,6 +74,16 @@ TEST(Pipeline, SimulatedScenarioAccuracy) {
         labels[msg->header.stamp] = msg;
         waiter.notify();
       });
+  std::map<ros::Time, double> fill;  // table stamp -> fraction of its cells with a class
+  ros::Subscriber lut_sub;
+  if (max_fill_ratio > 0) {
+    lut_sub = nh.subscribe<act_color::ColorLut>("/act/color_lut", 100, [&](const act_color::ColorLutConstPtr& msg) {
+      const double filled =
+          static_cast<double>(msg->table.size() - std::count(msg->table.begin(), msg->table.end(), 0));
+      std::lock_guard<std::mutex> lock(waiter.mutex());
+      fill[msg->header.stamp] = filled / static_cast<double>(msg->table.size());
+    });
+  }
   ros::AsyncSpinner spinner(2);
   spinner.start();
 
@@ -88,6 +108,26 @@ TEST(Pipeline, SimulatedScenarioAccuracy) {
   std::printf("pipeline on %s: %zu of %zu frames labeled; steady frames:\n%s", scenario_name.c_str(), labeled, frames,
               metrics.report().c_str());
   act_color_test::expectPerClassAtLeast(metrics, min_recall, min_precision);
+  if (max_fill_ratio > 0) {
+    // The table's fill before the flicker (after the start-up frames) and its largest during it.
+    double before = 0, during = 0;
+    int n_before = 0;
+    for (const auto& [stamp, f] : fill) {
+      auto i = index_of.find(stamp);
+      if (i == index_of.end()) continue;
+      if (i->second >= 4 && static_cast<int>(i->second) < flicker_start) {
+        before += f;
+        ++n_before;
+      } else if (static_cast<int>(i->second) >= flicker_start) {
+        during = std::max(during, f);
+      }
+    }
+    ASSERT_GT(n_before, 0) << "no table before the flicker";
+    before /= n_before;
+    std::printf("table fill before the flicker %.4f, largest during it %.4f (x%.2f; at most x%.2f)\n", before, during,
+                during / before, max_fill_ratio);
+    EXPECT_LE(during, max_fill_ratio * before);
+  }
 }
 
 }  // namespace
