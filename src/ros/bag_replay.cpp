@@ -1,13 +1,18 @@
 #include "act_color/ros/bag_replay.hpp"
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <ros/exception.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/String.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -15,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
+#include <sstream>
 #include <vector>
 
 #include "act_color/core/omni_camera_model.hpp"
@@ -80,33 +86,149 @@ size_t countTopic(const rosbag::Bag& bag, const std::string& topic, const std::s
   return view.size();
 }
 
+// A message of the bag as T; instantiate() gives null for another definition (md5sum) of the type.
+template <class T>
+boost::shared_ptr<T> instantiate(const rosbag::MessageInstance& m, const std::string& path) {
+  boost::shared_ptr<T> msg = m.instantiate<T>();
+  if (!msg) {
+    throw ReplayError(path + ": a message on " + m.getTopic() + " is a " + m.getDataType() +
+                      " of another definition (md5sum " + m.getMD5Sum() + ", expected " +
+                      ros::message_traits::MD5Sum<T>::value() + ")");
+  }
+  return msg;
+}
+
+std::string where(const std::string& topic, const ros::Time& stamp, size_t frame) {
+  std::ostringstream s;
+  s << topic << " at " << stamp << " (frame " << frame << ")";
+  return s.str();
+}
+
+// What to do about a bag that rosbag cannot read: most often one cut short (the recorder killed,
+// the disk full), whose index at the end of the file is missing.
+std::string reindexHint(const std::string& path) {
+  const std::filesystem::path p(path);
+  const std::string backup = (p.parent_path() / p.stem()).string() + ".orig" + p.extension().string();
+  return "it is truncated or corrupt; a bag cut short (a recording that was killed, a full disk) is usually recovered "
+         "with `rosbag reindex " +
+         path + "` (which keeps the original as " + backup + ")";
+}
+
+// rosbag's own magic line: tells "not a bag at all" from a damaged bag.
+bool startsLikeABag(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  char head[9] = {};
+  file.read(head, sizeof(head));
+  return file && std::string(head, sizeof(head)) == "#ROSBAG V";
+}
+
+// Why an image of `bytes_per_pixel` bytes per pixel cannot be read over its data, or "".
+std::string layoutProblem(const sensor_msgs::Image& image, size_t bytes_per_pixel) {
+  std::ostringstream s;
+  const uint64_t min_step = static_cast<uint64_t>(bytes_per_pixel) * image.width;
+  const uint64_t min_size = static_cast<uint64_t>(image.step) * image.height;
+  if (image.width == 0 || image.height == 0) {
+    s << "empty image (" << image.width << "x" << image.height << ")";
+  } else if (image.step < min_step) {
+    s << "step " << image.step << " is less than width " << image.width << " * " << bytes_per_pixel
+      << " bytes per pixel (" << image.encoding << ") = " << min_step;
+  } else if (image.data.size() < min_size) {
+    s << "data has " << image.data.size() << " bytes, less than step " << image.step << " * height " << image.height
+      << " = " << min_size;
+  }
+  return s.str();
+}
+
+// The output bag: written as PATH.active and renamed to PATH by commit(), removed when the replay
+// fails, so that no half-written bag is left looking complete.
+class OutputBag {
+ public:
+  explicit OutputBag(const std::string& path) : path_(path), active_(path + ".active") {
+    std::remove(path_.c_str());  // an older OUT.bag would look like this run's result
+    try {
+      bag_.open(active_, rosbag::bagmode::Write);
+    } catch (const rosbag::BagException& e) {
+      throw ReplayError(path_ + ": cannot be written: " + e.what());
+    }
+  }
+  OutputBag(const OutputBag&) = delete;
+  OutputBag& operator=(const OutputBag&) = delete;
+  ~OutputBag() {
+    if (committed_) return;
+    try {
+      bag_.close();
+    } catch (const std::exception&) {
+      // Removed below anyway.
+    }
+    std::remove(active_.c_str());
+  }
+  rosbag::Bag& bag() { return bag_; }
+  void commit() {
+    try {
+      bag_.close();
+    } catch (const rosbag::BagException& e) {
+      throw ReplayError(path_ + ": cannot be written: " + e.what());
+    }
+    if (std::rename(active_.c_str(), path_.c_str()) != 0) {
+      throw ReplayError(path_ + ": cannot be written: renaming " + active_ + " failed: " + std::strerror(errno));
+    }
+    committed_ = true;
+  }
+
+ private:
+  std::string path_, active_;
+  rosbag::Bag bag_;
+  bool committed_ = false;
+};
+
 }  // namespace
 
-ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
-  const core::Calibration calibration = core::loadCalibration(options.calibration);
-  if (options.lut_every == 0) throw ReplayError("--lut-every must be at least 1");
-  rosbag::Bag in;
-  try {
-    in.open(options.input_bag, rosbag::bagmode::Read);
-  } catch (const rosbag::BagException& e) {
-    throw ReplayError(options.input_bag + ": cannot be read as a bag: " + e.what());
+std::string imageMessageProblem(const sensor_msgs::Image& image) {
+  core::PixelFormat format;
+  if (!core::pixelFormatFromEncoding(image.encoding, &format)) {
+    return "unsupported encoding '" + image.encoding + "' (expected rgb8, bgr8 or yuv422)";
   }
-  const size_t image_count = countTopic(in, options.image_topic, "sensor_msgs/Image", options.input_bag);
+  const std::string problem = layoutProblem(image, core::bytesPerPixel(format));
+  if (problem.empty() && format == core::PixelFormat::kUyvy && image.width % 2 != 0) {
+    return "yuv422 image with an odd width " + std::to_string(image.width);
+  }
+  return problem;
+}
+
+std::string truthMessageProblem(const sensor_msgs::Image& truth, uint32_t width, uint32_t height) {
+  if (truth.encoding != "mono8") return "truth encoding '" + truth.encoding + "', expected mono8";
+  if (truth.width != width || truth.height != height) {
+    return "truth is " + std::to_string(truth.width) + "x" + std::to_string(truth.height) + ", its image " +
+           std::to_string(width) + "x" + std::to_string(height);
+  }
+  const std::string problem = layoutProblem(truth, 1);
+  return problem.empty() ? problem : "truth " + problem;
+}
+
+namespace {
+
+// The replay proper; runReplay() turns rosbag's and the deserializer's exceptions into ReplayError.
+// *writing_output: a partial output bag exists (and is removed when this throws); *frame: the
+// image being read.
+ReplayResult replay(const ReplayOptions& options, const core::Calibration& calibration, rosbag::Bag& in,
+                    std::ostream& log, bool* writing_output, size_t* frame) {
+  const std::string& path = options.input_bag;
+  const size_t image_count = countTopic(in, options.image_topic, "sensor_msgs/Image", path);
   if (image_count == 0) {
-    throw ReplayError(options.input_bag + ": no messages on the image topic " + options.image_topic +
+    throw ReplayError(path + ": no messages on the image topic " + options.image_topic +
                       "; topics in the bag: " + topicList(in));
   }
-  if (countTopic(in, options.pose_topic, "geometry_msgs/PoseWithCovarianceStamped", options.input_bag) == 0) {
-    throw ReplayError(options.input_bag + ": no messages on the pose topic " + options.pose_topic +
+  if (countTopic(in, options.pose_topic, "geometry_msgs/PoseWithCovarianceStamped", path) == 0) {
+    throw ReplayError(path + ": no messages on the pose topic " + options.pose_topic +
                       "; topics in the bag: " + topicList(in));
   }
-  countTopic(in, options.truth_topic, "sensor_msgs/Image", options.input_bag);
-  countTopic(in, options.events_topic, "std_msgs/String", options.input_bag);
+  countTopic(in, options.truth_topic, "sensor_msgs/Image", path);
+  countTopic(in, options.events_topic, "std_msgs/String", path);
 
   // Poses by stamp (small), truth and events indexed by stamp and read when needed.
   std::vector<StampedPose> poses;
   for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery(options.pose_topic))) {
-    const auto msg = m.instantiate<geometry_msgs::PoseWithCovarianceStamped>();
+    const auto msg = instantiate<geometry_msgs::PoseWithCovarianceStamped>(m, path);
     StampedPose p{msg->header.stamp, false, {}};
     std::string error;
     p.valid = ros_conversions::pose2D(msg->pose.pose, &p.pose, &error);
@@ -116,20 +238,16 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
                    [](const StampedPose& a, const StampedPose& b) { return a.stamp < b.stamp; });
   std::map<ros::Time, rosbag::MessageInstance> truth_by_stamp;
   for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery(options.truth_topic))) {
-    const auto header = m.instantiate<sensor_msgs::Image>()->header;
+    const auto header = instantiate<sensor_msgs::Image>(m, path)->header;
     truth_by_stamp.emplace(header.stamp, m);
   }
   std::vector<std::pair<ros::Time, std::string>> events;
   for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery(options.events_topic))) {
-    events.emplace_back(m.getTime(), m.instantiate<std_msgs::String>()->data);
+    events.emplace_back(m.getTime(), instantiate<std_msgs::String>(m, path)->data);
   }
 
-  rosbag::Bag out;
-  try {
-    out.open(options.output_bag, rosbag::bagmode::Write);
-  } catch (const rosbag::BagException& e) {
-    throw ReplayError(options.output_bag + ": cannot be written: " + e.what());
-  }
+  OutputBag out(options.output_bag);
+  *writing_output = true;
 
   core::ActTrainer trainer(calibration, options.params);
   const core::Segmenter segmenter(calibration.camera);
@@ -141,9 +259,16 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
   bool bootstrapped = false;
   size_t next_event = 0;
   auto last_progress = std::chrono::steady_clock::now();
+  // The first few of each kind in full, then only counted (the summary has the totals).
+  auto warn = [&log](size_t seen_before, const char* kind, const std::string& message) {
+    constexpr size_t kShown = 5;
+    if (seen_before < kShown) log << "act_replay: warning: " << message << "\n";
+    if (seen_before + 1 == kShown) log << "act_replay: further " << kind << " are only counted\n";
+  };
 
   for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery(options.image_topic))) {
-    const auto image = m.instantiate<sensor_msgs::Image>();
+    *frame = result.images;
+    const auto image = instantiate<sensor_msgs::Image>(m, path);
     const ros::Time stamp = image->header.stamp;
     while (next_event < events.size() && events[next_event].first <= stamp) {
       result.evaluation.markEvent(events[next_event++].second);
@@ -153,9 +278,10 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
                                   [](const ros::Time& t, const StampedPose& p) { return t < p.stamp; });
     const StampedPose* pose = after == poses.begin() ? nullptr : &*(after - 1);
 
+    // Nothing of the message is read before it has been checked against itself.
     core::ImageView view;
-    std::string error;
-    bool usable = ros_conversions::imageView(*image, &view, &error);
+    std::string error = imageMessageProblem(*image);
+    bool usable = error.empty() && ros_conversions::imageView(*image, &view, &error);
     if (usable) {
       try {
         trainer.checkImage(view);
@@ -165,7 +291,9 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
       }
     }
     if (!usable) {
-      if (result.unusable_images++ < 5) log << "act_replay: frame " << result.images << ": " << error << "\n";
+      warn(result.unusable_images++, "unusable images",
+           where(options.image_topic, stamp, result.images) + ": " + error +
+               "; labelled all unknown, not trained, left out of the metrics");
       labels.setTo(core::kUnknown);
     } else {
       if (pose && pose->valid) {
@@ -181,17 +309,28 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
       }
       segmenter.classify(trainer.lut(), view, labels);
     }
-    out.write("/segmentation/labels", m.getTime(), ros_conversions::labelsToMsg(labels, image->header));
+    out.bag().write("/segmentation/labels", m.getTime(), ros_conversions::labelsToMsg(labels, image->header));
     if (result.images % options.lut_every == 0) {
       std_msgs::Header header = image->header;
-      out.write("/act/color_lut", m.getTime(), ros_conversions::toMsg(trainer, header));
+      out.bag().write("/act/color_lut", m.getTime(), ros_conversions::toMsg(trainer, header));
     }
     const auto truth_it = truth_by_stamp.find(stamp);
+    sensor_msgs::ImageConstPtr truth;
     cv::Mat truth_mat;
     if (truth_it != truth_by_stamp.end()) {
-      const auto truth = truth_it->second.instantiate<sensor_msgs::Image>();
-      if (truth->encoding == "mono8" && truth->width == image->width && truth->height == image->height) {
-        truth_mat = cv::Mat(truth->height, truth->width, CV_8UC1, truth->data.data(), truth->step).clone();
+      truth = instantiate<sensor_msgs::Image>(truth_it->second, path);
+      const std::string problem = truthMessageProblem(*truth, image->width, image->height);
+      if (!problem.empty()) {
+        ++result.truth_left_out;
+        warn(result.unusable_truth++, "unusable truth images",
+             where(options.truth_topic, stamp, result.images) + ": " + problem +
+                 "; the frame's labels are written, the frame is left out of the metrics");
+      } else if (!usable) {
+        ++result.truth_left_out;
+      } else {
+        // Checked above: step and data cover height rows of width bytes.
+        truth_mat =
+            cv::Mat(truth->height, truth->width, CV_8UC1, const_cast<uint8_t*>(truth->data.data()), truth->step);
         result.evaluation.addFrame(labels, truth_mat);
         ++result.with_truth;
       }
@@ -208,7 +347,8 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
       last_progress = now;
     }
   }
-  out.close();
+  out.commit();
+  *writing_output = false;
   if (self_mask) {
     core::CameraCalibration camera = calibration.camera;
     camera.self_mask = self_mask->mask();
@@ -234,6 +374,43 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
     csv << result.evaluation.csv();
   }
   return result;
+}
+
+}  // namespace
+
+ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
+  const core::Calibration calibration = core::loadCalibration(options.calibration);
+  if (options.lut_every == 0) throw ReplayError("--lut-every must be at least 1");
+  std::error_code ec;
+  if (std::filesystem::equivalent(options.input_bag, options.output_bag, ec)) {
+    throw ReplayError(options.output_bag + ": is the input bag; choose another --output");
+  }
+  const std::string& path = options.input_bag;
+  if (!std::ifstream(path)) throw ReplayError(path + ": cannot be opened: " + std::strerror(errno));
+  rosbag::Bag in;
+  try {
+    in.open(path, rosbag::bagmode::Read);
+  } catch (const rosbag::BagException& e) {
+    if (!startsLikeABag(path)) throw ReplayError(path + ": cannot be read as a bag: not a rosbag file");
+    throw ReplayError(path + ": cannot be read as a bag (" + e.what() + "): " + reindexHint(path));
+  }
+  bool writing_output = false;
+  size_t frame = 0;
+  // The partial output bag has been removed by the time these run.
+  const std::string not_written = "; " + options.output_bag + " not written (the partial output was removed)";
+  try {
+    return replay(options, calibration, in, log, &writing_output, &frame);
+  } catch (const ros::Exception& e) {
+    // rosbag::BagException (a chunk or record that cannot be read), or the deserializer running
+    // past a message's end: the file is damaged.
+    std::string message = path + ": reading failed";
+    if (writing_output) message += " at frame " + std::to_string(frame);
+    message += " (" + std::string(e.what()) + "): " + reindexHint(path);
+    throw ReplayError(writing_output ? message + not_written : message);
+  } catch (const std::exception& e) {
+    if (!writing_output) throw;
+    throw ReplayError(e.what() + not_written);
+  }
 }
 
 }  // namespace ros_layer

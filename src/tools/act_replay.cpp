@@ -142,14 +142,33 @@ int main(int argc, char** argv) {
     std::cout << "act_replay: " << result.images << " frames from " << options.input_bag << " (" << result.trained
               << " trained, " << result.without_pose << " without a usable pose, " << result.unusable_images
               << " unusable images, " << result.with_truth << " with truth); wrote " << options.output_bag << "\n";
+    if (result.truth_left_out > 0) {
+      const size_t bad_image = result.truth_left_out - result.unusable_truth;
+      std::cout << "act_replay: warning: " << result.truth_left_out << " of "
+                << result.truth_left_out + result.with_truth << " frames with truth left out of the metrics (";
+      if (result.unusable_truth) std::cout << result.unusable_truth << " with a truth image that does not fit";
+      if (result.unusable_truth && bad_image) std::cout << ", ";
+      if (bad_image) std::cout << bad_image << " with an unusable image";
+      std::cout << "; see the warnings on stderr)\n";
+    }
     if (!options.self_mask_png.empty()) {
       std::printf(
           "act_replay: self mask learned from %d poses: %.2f%% of the imaged pixels; wrote %s (set camera.self_mask "
           "to it)\n",
           result.self_mask_poses, 100.0 * result.self_mask_fraction, options.self_mask_png.c_str());
     }
-    if (result.with_truth > 0) std::cout << (brief ? result.evaluation.brief() : result.evaluation.report());
-    return result.images > result.unusable_images ? 0 : 1;
+    if (result.with_truth > 0) {
+      std::cout << (brief ? result.evaluation.brief() : result.evaluation.report());
+    } else {
+      std::cout << "act_replay: no frame with truth on " << options.truth_topic << ": no metrics\n";
+    }
+    std::cout << std::flush;
+    if (result.images == result.unusable_images) {
+      std::cerr << "act_replay: none of the " << result.images << " images of " << options.input_bag
+                << " is usable (see the warnings above)\n";
+      return 1;
+    }
+    return 0;
   } catch (const std::exception& e) {
     std::cerr << "act_replay: " << e.what() << "\n";
     return 1;

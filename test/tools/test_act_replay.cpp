@@ -5,8 +5,12 @@
 #include <rosbag/view.h>
 #include <sensor_msgs/Image.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <sstream>
 #include <string>
@@ -48,6 +52,64 @@ std::string readBytes(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
 }
+
+// Runs a shell command with stdout and stderr into *output; returns its exit status.
+int run(const std::string& command, std::string* output) {
+  const std::string file = tempDir() + "/command_output.txt";
+  const int status = std::system((command + " > " + file + " 2>&1").c_str());
+  *output = readBytes(file);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// Changes an image or truth message of the copy; false drops it.
+using Mutation = std::function<bool(const std::string& topic, size_t frame, sensor_msgs::Image& image)>;
+
+// The first `frames` frames of `in` (every message stamped at or before the last of their
+// images), uncompressed, with `mutate` applied to each image and truth message (`frame`: the
+// image's index). With images_last, every image is written after all other messages, so that the
+// last chunks of the file hold images only.
+void copyBag(const std::string& in, const std::string& out, size_t frames, const Mutation& mutate,
+             bool images_last = false) {
+  rosbag::Bag input(in);
+  std::vector<ros::Time> image_times;
+  for (const auto& m : rosbag::View(input, rosbag::TopicQuery("/omni/image_raw"))) image_times.push_back(m.getTime());
+  ASSERT_GE(image_times.size(), frames);
+  const ros::Time last = image_times[frames - 1];
+  rosbag::Bag output(out, rosbag::bagmode::Write);
+  auto frameOf = [&](const ros::Time& t) {
+    return static_cast<size_t>(std::lower_bound(image_times.begin(), image_times.end(), t) - image_times.begin());
+  };
+  for (int pass = 0; pass < (images_last ? 2 : 1); ++pass) {
+    for (const auto& m : rosbag::View(input, ros::TIME_MIN, last)) {
+      const bool is_image = m.getTopic() == "/omni/image_raw";
+      if (images_last && is_image != (pass == 1)) continue;
+      if (is_image || m.getTopic() == "/omni/labels_truth") {
+        auto image = m.instantiate<sensor_msgs::Image>();
+        if (mutate(m.getTopic(), frameOf(m.getTime()), *image)) output.write(m.getTopic(), m.getTime(), image);
+      } else {
+        output.write(m.getTopic(), m.getTime(), m);
+      }
+    }
+  }
+}
+
+const Mutation kUnchanged = [](const std::string&, size_t, sensor_msgs::Image&) { return true; };
+
+// The stamp of image `frame` as act_replay prints it.
+std::string imageStamp(const std::string& bag, size_t frame) {
+  rosbag::Bag input(bag);
+  size_t i = 0;
+  for (const auto& m : rosbag::View(input, rosbag::TopicQuery("/omni/image_raw"))) {
+    if (i++ == frame) {
+      std::ostringstream s;
+      s << m.instantiate<sensor_msgs::Image>()->header.stamp;
+      return s.str();
+    }
+  }
+  return "no such frame";
+}
+
+bool exists(const std::string& path) { return std::filesystem::exists(path); }
 
 ReplayOptions options(const std::string& in, const std::string& out) {
   ReplayOptions o;
@@ -160,7 +222,11 @@ TEST(ActReplay, ClearErrorsForUnusableInput) {
   EXPECT_NE(errorOf(o).find("has type sensor_msgs/Image"), std::string::npos);
   const std::string junk = tempDir() + "/junk.bag";
   std::ofstream(junk) << "this is not a bag";
-  EXPECT_NE(errorOf(options(junk, tempDir() + "/x.bag")).find("cannot be read as a bag"), std::string::npos);
+  EXPECT_NE(errorOf(options(junk, tempDir() + "/x.bag")).find("cannot be read as a bag: not a rosbag file"),
+            std::string::npos);
+  EXPECT_NE(errorOf(options(tempDir() + "/missing.bag", tempDir() + "/x.bag")).find("cannot be opened"),
+            std::string::npos);
+  EXPECT_NE(errorOf(options(in, in)).find("is the input bag"), std::string::npos);
   o = options(in, tempDir() + "/x.bag");
   o.calibration = "/nonexistent.yaml";
   EXPECT_NE(errorOf(o).find("/nonexistent.yaml"), std::string::npos);
@@ -171,6 +237,223 @@ TEST(ActReplay, ClearErrorsForUnusableInput) {
                                      tempDir() + "/x.bag 2> /dev/null")
                                         .c_str())),
             1);
+}
+
+TEST(ActReplay, MessageChecksSayWhatIsWrong) {
+  using act_color::ros_layer::imageMessageProblem;
+  using act_color::ros_layer::truthMessageProblem;
+  sensor_msgs::Image image;
+  image.encoding = "rgb8";
+  image.width = 4;
+  image.height = 3;
+  image.step = 12;
+  image.data.resize(36);
+  EXPECT_EQ(imageMessageProblem(image), "");
+  image.step = 11;
+  EXPECT_EQ(imageMessageProblem(image), "step 11 is less than width 4 * 3 bytes per pixel (rgb8) = 12");
+  image.step = 16;
+  EXPECT_EQ(imageMessageProblem(image), "data has 36 bytes, less than step 16 * height 3 = 48");
+  image.encoding = "yuv422";
+  image.width = 5;
+  image.step = 10;
+  image.data.resize(30);
+  EXPECT_EQ(imageMessageProblem(image), "yuv422 image with an odd width 5");
+  image.encoding = "mono16";
+  EXPECT_NE(imageMessageProblem(image).find("unsupported encoding 'mono16'"), std::string::npos);
+  image.encoding = "bgr8";
+  image.height = 0;
+  EXPECT_EQ(imageMessageProblem(image), "empty image (5x0)");
+  // Huge sizes do not overflow the check: 4e9 rows of 4e9 bytes.
+  image.width = image.height = image.step = 4000000000u;
+  EXPECT_NE(imageMessageProblem(image), "");
+
+  sensor_msgs::Image truth;
+  truth.encoding = "mono8";
+  truth.width = 4;
+  truth.height = 3;
+  truth.step = 4;
+  truth.data.resize(11);
+  EXPECT_EQ(truthMessageProblem(truth, 4, 3), "truth data has 11 bytes, less than step 4 * height 3 = 12");
+  truth.data.resize(12);
+  EXPECT_EQ(truthMessageProblem(truth, 4, 3), "");
+  EXPECT_EQ(truthMessageProblem(truth, 4, 4), "truth is 4x3, its image 4x4");
+  truth.step = 3;
+  EXPECT_EQ(truthMessageProblem(truth, 4, 3), "truth step 3 is less than width 4 * 1 bytes per pixel (mono8) = 4");
+  truth.encoding = "8UC1";
+  EXPECT_EQ(truthMessageProblem(truth, 4, 3), "truth encoding '8UC1', expected mono8");
+}
+
+// A truth image shorter than step * height (issue 15): never read past its data; that frame's
+// labels are written, the frame is left out of the metrics and the tool says so. Exit 0: the
+// labels are complete.
+TEST(ActReplay, ShortTruthIsLeftOutOfTheMetrics) {
+  const std::string in = tempDir() + "/short_truth.bag";
+  copyBag(scenarioBag("static_darkening"), in, 10, [](const std::string& topic, size_t frame, sensor_msgs::Image& m) {
+    if (topic == "/omni/labels_truth" && frame == 3) m.data.resize(m.data.size() / 2);
+    return true;
+  });
+  // The same frames without that truth message: what the metrics must equal.
+  const std::string without = tempDir() + "/without_truth_3.bag";
+  copyBag(scenarioBag("static_darkening"), without, 10,
+          [](const std::string& topic, size_t frame, sensor_msgs::Image&) {
+            return !(topic == "/omni/labels_truth" && frame == 3);
+          });
+  std::ostringstream log;
+  const auto result = runReplay(options(in, tempDir() + "/short_truth.out.bag"), log);
+  EXPECT_EQ(result.images, 10u);
+  EXPECT_EQ(result.trained, 10u);
+  EXPECT_EQ(result.with_truth, 9u);
+  EXPECT_EQ(result.unusable_truth, 1u);
+  EXPECT_EQ(result.truth_left_out, 1u);
+  EXPECT_EQ(result.evaluation.frames(), 9u);
+  EXPECT_NE(log.str().find("/omni/labels_truth at " + imageStamp(in, 3) +
+                           " (frame 3): truth data has 168200 bytes, less than step 580 * height 580 = 336400"),
+            std::string::npos)
+      << log.str();
+  std::ostringstream log_without;
+  const auto reference = runReplay(options(without, tempDir() + "/without_truth_3.out.bag"), log_without);
+  EXPECT_EQ(reference.with_truth, 9u);
+  EXPECT_EQ(result.evaluation.overall().confusion(), reference.evaluation.overall().confusion());
+  rosbag::Bag output(tempDir() + "/short_truth.out.bag");
+  EXPECT_EQ(rosbag::View(output, rosbag::TopicQuery("/segmentation/labels")).size(), 10u);
+
+  std::string text;
+  const std::string tool = std::string(ACT_TOOLS_DIR) + "/act_replay --no-progress --brief --calibration " +
+                           kCalibration + " --output " + tempDir() + "/short_truth.tool.bag --bag ";
+  EXPECT_EQ(run(tool + in, &text), 0) << text;
+  EXPECT_NE(
+      text.find("10 frames from " + in + " (10 trained, 0 without a usable pose, 0 unusable images, 9 with truth)"),
+      std::string::npos)
+      << text;
+  EXPECT_NE(text.find("1 of 10 frames with truth left out of the metrics (1 with a truth image that does not fit"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("green"), std::string::npos) << text;
+
+  // No truth image fits (step too small): no metrics at all, said in words, not as numbers.
+  const std::string none = tempDir() + "/no_truth_fits.bag";
+  copyBag(scenarioBag("static_darkening"), none, 4, [](const std::string& topic, size_t, sensor_msgs::Image& m) {
+    if (topic == "/omni/labels_truth") m.step = 100;
+    return true;
+  });
+  EXPECT_EQ(run(tool + none, &text), 0) << text;
+  EXPECT_NE(text.find("4 of 4 frames with truth left out of the metrics (4 with a truth image that does not fit"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("truth step 100 is less than width 580"), std::string::npos) << text;
+  EXPECT_NE(text.find("no frame with truth on /omni/labels_truth: no metrics"), std::string::npos) << text;
+  EXPECT_EQ(text.find("recall"), std::string::npos) << text;
+  EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+}
+
+// Images whose step is too small or whose data is short: labelled all unknown, not trained, left
+// out of the metrics, each named by topic, stamp and what is wrong. Exit 0 while some image is
+// usable, 1 when none is.
+TEST(ActReplay, ImagesThatDoNotFitTheirStepAreSkipped) {
+  const std::string in = tempDir() + "/bad_images.bag";
+  copyBag(scenarioBag("static_darkening"), in, 10, [](const std::string& topic, size_t frame, sensor_msgs::Image& m) {
+    if (topic == "/omni/image_raw" && frame == 3) m.step = m.width;
+    if (topic == "/omni/image_raw" && frame == 5) m.data.resize(1000);
+    return true;
+  });
+  std::ostringstream log;
+  const auto result = runReplay(options(in, tempDir() + "/bad_images.out.bag"), log);
+  EXPECT_EQ(result.images, 10u);
+  EXPECT_EQ(result.unusable_images, 2u);
+  EXPECT_EQ(result.trained, 8u);
+  EXPECT_EQ(result.with_truth, 8u);
+  EXPECT_EQ(result.truth_left_out, 2u);
+  EXPECT_EQ(result.unusable_truth, 0u);
+  EXPECT_NE(log.str().find("/omni/image_raw at " + imageStamp(in, 3) +
+                           " (frame 3): step 580 is less than width 580 * 3 bytes per pixel (rgb8) = 1740"),
+            std::string::npos)
+      << log.str();
+  EXPECT_NE(log.str().find("/omni/image_raw at " + imageStamp(in, 5) +
+                           " (frame 5): data has 1000 bytes, less than step 1740 * height 580 = 1009200"),
+            std::string::npos)
+      << log.str();
+  // The skipped frames' labels are there, all unknown.
+  rosbag::Bag output(tempDir() + "/bad_images.out.bag");
+  size_t i = 0;
+  for (const auto& m : rosbag::View(output, rosbag::TopicQuery("/segmentation/labels"))) {
+    const auto labels = m.instantiate<sensor_msgs::Image>();
+    const size_t unknown = std::count(labels->data.begin(), labels->data.end(), act_color::core::kUnknown);
+    if (i == 3 || i == 5) {
+      EXPECT_EQ(unknown, labels->data.size()) << "frame " << i;
+    } else {
+      EXPECT_LT(unknown, labels->data.size() / 2) << "frame " << i;
+    }
+    ++i;
+  }
+  EXPECT_EQ(i, 10u);
+
+  std::string text;
+  const std::string tool = std::string(ACT_TOOLS_DIR) + "/act_replay --no-progress --brief --calibration " +
+                           kCalibration + " --output " + tempDir() + "/bad_images.tool.bag --bag ";
+  EXPECT_EQ(run(tool + in, &text), 0) << text;
+  EXPECT_NE(text.find("(8 trained, 0 without a usable pose, 2 unusable images, 8 with truth)"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("2 of 10 frames with truth left out of the metrics (2 with an unusable image"), std::string::npos)
+      << text;
+  const std::string all_bad = tempDir() + "/all_bad_images.bag";
+  copyBag(scenarioBag("static_darkening"), all_bad, 3, [](const std::string& topic, size_t, sensor_msgs::Image& m) {
+    if (topic == "/omni/image_raw") m.step = 7;
+    return true;
+  });
+  EXPECT_EQ(run(tool + all_bad, &text), 1) << text;
+  EXPECT_NE(text.find("none of the 3 images of " + all_bad + " is usable"), std::string::npos) << text;
+  EXPECT_NE(text.find("no frame with truth"), std::string::npos) << text;
+}
+
+// A bag cut short (its index at the end is missing): exit 1, the file named, `rosbag reindex`
+// suggested, no output bag; and the suggestion works.
+TEST(ActReplay, TruncatedBagSuggestsReindex) {
+  const std::string in = tempDir() + "/truncated.bag";
+  copyBag(scenarioBag("static_darkening"), in, 10, kUnchanged);
+  const auto size = std::filesystem::file_size(in);
+  std::filesystem::resize_file(in, size / 2);
+  const std::string out = tempDir() + "/truncated.out.bag";
+  std::string text;
+  const std::string tool = std::string(ACT_TOOLS_DIR) + "/act_replay --no-progress --brief --calibration " +
+                           kCalibration + " --output " + out + " --bag " + in;
+  EXPECT_EQ(run(tool, &text), 1) << text;
+  EXPECT_NE(text.find(in + ": cannot be read as a bag"), std::string::npos) << text;
+  EXPECT_NE(text.find("`rosbag reindex " + in + "`"), std::string::npos) << text;
+  EXPECT_FALSE(exists(out));
+  EXPECT_FALSE(exists(out + ".active"));
+  // What the message suggests gives a bag act_replay reads: the frames before the cut.
+  ASSERT_EQ(std::system(("PYENV_VERSION=system rosbag reindex -q " + in + " > /dev/null 2>&1").c_str()), 0);
+  EXPECT_TRUE(exists(tempDir() + "/truncated.orig.bag"));
+  EXPECT_EQ(run(tool, &text), 0) << text;
+  EXPECT_EQ(text.find("10 frames from"), std::string::npos) << text;
+  EXPECT_NE(text.find("frames from " + in), std::string::npos) << text;
+  EXPECT_TRUE(exists(out));
+}
+
+// A chunk that cannot be read in the middle of the replay (after labels were written): exit 1,
+// the file and the image named, and neither the partial output nor an older OUT.bag left behind.
+TEST(ActReplay, CorruptChunkLeavesNoPartialOutput) {
+  const std::string in = tempDir() + "/corrupt_chunk.bag";
+  copyBag(scenarioBag("static_darkening"), in, 10, kUnchanged, /*images_last=*/true);
+  std::string bytes = readBytes(in);
+  const std::string field = "compression=none";
+  const size_t last_chunk = bytes.rfind(field);
+  ASSERT_NE(last_chunk, std::string::npos);
+  bytes.replace(last_chunk, field.size(), "compression=nonf");
+  std::ofstream(in, std::ios::binary) << bytes;
+  const std::string out = tempDir() + "/corrupt_chunk.out.bag";
+  std::ofstream(out) << "an older output";
+  std::string text;
+  EXPECT_EQ(run(std::string(ACT_TOOLS_DIR) + "/act_replay --no-progress --calibration " + kCalibration + " --output " +
+                    out + " --bag " + in,
+                &text),
+            1)
+      << text;
+  EXPECT_NE(text.find(in + ": reading failed at frame 9 (Unknown compression: nonf)"), std::string::npos) << text;
+  EXPECT_NE(text.find("`rosbag reindex " + in + "`"), std::string::npos) << text;
+  EXPECT_NE(text.find(out + " not written (the partial output was removed)"), std::string::npos) << text;
+  EXPECT_FALSE(exists(out));
+  EXPECT_FALSE(exists(out + ".active"));
 }
 
 // act_eval's command line: one family scene, its report on stdout; a family bag and calibration

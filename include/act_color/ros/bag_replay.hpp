@@ -1,5 +1,8 @@
 #pragma once
 
+#include <sensor_msgs/Image.h>
+
+#include <cstdint>
 #include <ostream>
 #include <stdexcept>
 #include <string>
@@ -34,23 +37,37 @@ struct ReplayOptions {
 
 struct ReplayResult {
   size_t images = 0;
-  size_t trained = 0;          // frames with a usable pose
-  size_t without_pose = 0;     // frames before the first pose, or with a NaN pose
-  size_t unusable_images = 0;  // wrong encoding or size: labelled all unknown
-  size_t with_truth = 0;
+  size_t trained = 0;             // frames with a usable pose
+  size_t without_pose = 0;        // frames before the first pose, or with a NaN pose
+  size_t unusable_images = 0;     // encoding, size, step or data unfit: labelled all unknown, left out of the metrics
+  size_t with_truth = 0;          // frames in the metrics (a usable image and a usable truth image)
+  size_t unusable_truth = 0;      // truth images that do not fit their image (encoding, size, step, data)
+  size_t truth_left_out = 0;      // frames with a truth image left out of the metrics (unusable truth or image)
   int self_mask_poses = 0;        // distinct poses the self mask was learned from
   double self_mask_fraction = 0;  // of the imaged pixels
   core::RunEvaluation evaluation;
 };
 
-// Thrown for a bag or calibration that cannot be used at all; the message says why.
+// Thrown for a bag or calibration that cannot be used at all; the message says why. Nothing is
+// left at the output path when runReplay throws after it started writing (OUT.bag is written as
+// OUT.bag.active and renamed when complete).
 class ReplayError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
 
+// Why a camera image message cannot be read safely (encoding rgb8, bgr8 or yuv422; width and
+// height not 0; step >= width * bytes per pixel; data.size() >= step * height; an even width for
+// yuv422), or "" when it can. Checks the message against itself only, not against a calibration.
+std::string imageMessageProblem(const sensor_msgs::Image& image);
+// The same for a truth label image: mono8, `width` x `height` (those of its camera image), step
+// >= width, data.size() >= step * height.
+std::string truthMessageProblem(const sensor_msgs::Image& truth, uint32_t width, uint32_t height);
+
 // Runs ACT and the segmentation over every image of the input bag, in order, with the pose
 // nearest in time at or before each image; writes /segmentation/labels and /act/color_lut.
+// A frame whose image or truth message does not fit is skipped with a warning on `log` (counted in
+// the result); a truncated or corrupt bag throws ReplayError naming the file and `rosbag reindex`.
 ReplayResult runReplay(const ReplayOptions& options, std::ostream& log);
 
 }  // namespace ros_layer
