@@ -105,8 +105,6 @@ class ActTrainerNodelet : public nodelet::Nodelet {
 
   // Everything below is guarded by mutex_.
   mutable std::mutex mutex_;
-  std::thread configure_thread_;
-  bool configuring_ = true;   // until configure() has run
   std::string config_error_;  // non-empty: the nodelet could not be configured and does nothing
   std::unique_ptr<core::ActTrainer> trainer_;
   std::unique_ptr<core::Segmenter> segmenter_;
@@ -150,7 +148,6 @@ class ActTrainerNodelet : public nodelet::Nodelet {
 };
 
 ActTrainerNodelet::~ActTrainerNodelet() {
-  if (configure_thread_.joinable()) configure_thread_.join();
   // No service call may run into a half-destroyed nodelet.
   if (io_spinner_) io_spinner_->stop();
   // ~save_on_shutdown: the table of this run survives the robot's restart. Never throws.
@@ -177,17 +174,12 @@ void ActTrainerNodelet::onInit() {
   updater_ = ros_conversions::makeDiagnostics(
       nh_, pnh_, getName(), "ACT trainer", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
       &diagnostics_timer_);
-  // The calibration is read and the camera model built on a thread of its own: a large file or
-  // camera must not hold up the manager's loading of the other nodelets (onInit returns at once).
-  configure_thread_ = std::thread([this] {
-    const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
+  const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
+  if (!error.empty()) {
+    NODELET_ERROR("not started: %s", error.c_str());
     std::lock_guard<std::mutex> lock(mutex_);
-    configuring_ = false;
-    if (!error.empty()) {
-      NODELET_ERROR("not started: %s", error.c_str());
-      config_error_ = error;
-    }
-  });
+    config_error_ = error;
+  }
 }
 
 bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) {
@@ -874,10 +866,6 @@ bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& re
 void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
-  if (configuring_) {
-    status.summary(DiagnosticStatus::OK, "starting: reading the calibration");
-    return;
-  }
   if (!config_error_.empty() || !trainer_) {
     status.summary(DiagnosticStatus::ERROR, "not configured: " + config_error_);
     return;

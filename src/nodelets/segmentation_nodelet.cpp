@@ -16,7 +16,6 @@
 #include <mutex>
 #include <pluginlib/class_list_macros.hpp>
 #include <string>
-#include <thread>
 
 #include "act_color/ColorLut.h"
 #include "act_color/SegmentationConfig.h"
@@ -33,11 +32,6 @@
 namespace act_color {
 
 class SegmentationNodelet : public nodelet::Nodelet {
- public:
-  ~SegmentationNodelet() override {
-    if (configure_thread_.joinable()) configure_thread_.join();
-  }
-
  private:
   struct PendingImage {
     sensor_msgs::ImageConstPtr image;
@@ -77,8 +71,6 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::unique_ptr<ros_conversions::CheckedReconfigure<SegmentationConfig>> reconfigure_;
 
   std::mutex mutex_;  // guards everything below
-  std::thread configure_thread_;
-  bool configuring_ = true;  // until configure() has run
   std::string config_error_;
   std::unique_ptr<core::OmniCameraModel> camera_;
   std::unique_ptr<core::Segmenter> segmenter_;
@@ -110,17 +102,12 @@ void SegmentationNodelet::onInit() {
   updater_ = ros_conversions::makeDiagnostics(
       nh_, pnh_, getName(), "segmentation", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
       &diagnostics_timer_);
-  // The calibration is read and the camera model built on a thread of its own: a large file or
-  // camera must not hold up the manager's loading of the other nodelets (onInit returns at once).
-  configure_thread_ = std::thread([this] {
-    const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
+  const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
+  if (!error.empty()) {
+    NODELET_ERROR("not started: %s", error.c_str());
     std::lock_guard<std::mutex> lock(mutex_);
-    configuring_ = false;
-    if (!error.empty()) {
-      NODELET_ERROR("not started: %s", error.c_str());
-      config_error_ = error;
-    }
-  });
+    config_error_ = error;
+  }
 }
 
 bool SegmentationNodelet::configure(std::string* error) {
@@ -435,10 +422,6 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
 void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
-  if (configuring_) {
-    status.summary(DiagnosticStatus::OK, "starting: reading the calibration");
-    return;
-  }
   if (!config_error_.empty() || !segmenter_) {
     status.summary(DiagnosticStatus::ERROR, "not configured: " + config_error_);
     return;
