@@ -496,23 +496,27 @@ bool ActTrainer::restoreLightState() {
   }
   if (best == nullptr) return false;
   // Swap: the light left takes the restored one's place.
-  LightModel observed = light_;  // this cycle's anchors
   std::swap(lut_, best->lut);
   neighbour_only_.swap(best->neighbour_only);
   evidence_.swap(best->evidence);
   confirmed_.swap(best->confirmed);
   std::swap(clusters_, best->clusters);
   std::swap(light_, best->light);
-  best->light = observed;  // the light left: its reference
   best->left_at = revision_;
-  light_.adoptObservation(observed);  // the light restored: its reference, this cycle's anchors
+  // The light restored keeps its reference and takes this cycle's anchors from the light left.
+  light_.adoptObservation(best->light);
   rebuildMapped();
   ball_hypotheses_.clear();
   return true;
 }
 
 void ActTrainer::keepLightState() {
+  // The oldest state's buffers are reused when the memory is full: no allocation then.
   LightState s;
+  if (light_states_.size() >= kMaxLightStates) {
+    s = std::move(light_states_.front());
+    light_states_.erase(light_states_.begin());
+  }
   s.lut = lut_;
   s.neighbour_only = neighbour_only_;
   s.evidence = evidence_;
@@ -520,7 +524,6 @@ void ActTrainer::keepLightState() {
   s.clusters = clusters_;
   s.light = light_;
   s.left_at = revision_;
-  if (light_states_.size() >= kMaxLightStates) light_states_.erase(light_states_.begin());
   light_states_.push_back(std::move(s));
 }
 

@@ -142,7 +142,7 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   // ... and the last seconds.
   static constexpr double kWindowS = 5.0;
   static constexpr double kFillWindowS = 30.0;
-  std::deque<Record> window_;
+  ros_conversions::RecentWindow<Record> window_{kWindowS};
   std::deque<std::pair<ros::WallTime, uint64_t>> fill_history_;  // filled cells, once per diagnostics
   ros::WallTime last_image_;
 };
@@ -449,19 +449,8 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
       outside("lut_throttled_period", c.lut_throttled_period, 0.0, 3600.0, false)) {
     return false;
   }
-  if (p.lut_bits != params_.lut_bits || p.seed != params_.seed) params_changed_ = true;
-  params_changed_ =
-      params_changed_ ||
-      !(p.eta == params_.eta && p.zeta == params_.zeta && p.xi == params_.xi && p.sigma_min == params_.sigma_min &&
-        p.cluster_stride == params_.cluster_stride && p.add_stride == params_.add_stride &&
-        p.remove_stride == params_.remove_stride && p.white_filter == params_.white_filter &&
-        p.add_neighbourhood_cells == params_.add_neighbourhood_cells &&
-        p.light_compensation == params_.light_compensation &&
-        p.light_change_add_stride == params_.light_change_add_stride &&
-        p.removal_protect_cycles == params_.removal_protect_cycles &&
-        p.robots_train_black == params_.robots_train_black && p.nearest_mean == params_.nearest_mean &&
-        p.evidence_removal_ratio == params_.evidence_removal_ratio && p.ball_training == params_.ball_training &&
-        p.ball_diameter_m == params_.ball_diameter_m);
+  // ActTrainer::setParams keeps what did not change (the table, the generator, the ball detector).
+  params_changed_ = true;
   params_ = p;  // applied by the next image, in the image callback
   max_pose_age_s_ = c.max_pose_age;
   pose_source_.setMaxAge(c.max_pose_age);
@@ -517,8 +506,7 @@ void ActTrainerNodelet::onTimeJump(const ros::Time& from, const ros::Time& to) {
 
 void ActTrainerNodelet::record(Outcome outcome, double cycle_ms, double latency_ms) {
   const ros::WallTime now = ros::WallTime::now();
-  window_.push_back({now, outcome, cycle_ms, latency_ms});
-  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+  window_.add({now, outcome, cycle_ms, latency_ms});
 }
 
 bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_wait) {
@@ -871,7 +859,7 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
     return;
   }
   const ros::WallTime now = ros::WallTime::now();
-  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+  window_.trim(now);
   size_t trained = 0, no_pose = 0, rejected = 0, cycles = 0, latencies = 0;
   double sum_ms = 0, max_ms = 0, sum_latency = 0, max_latency = 0;
   for (const Record& r : window_) {
@@ -900,7 +888,7 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   }
   uint64_t max_filled = 0;
   for (const auto& f : fill_history_) max_filled = std::max(max_filled, f.second);
-  auto percent = [](double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0.0; };
+  using ros_conversions::percent;
   const double fill_percent = percent(filled, trainer_->lut().size());
 
   status.summary(DiagnosticStatus::OK, "training");
@@ -934,8 +922,7 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
       << "% of its cells in " << kFillWindowS << " s";
     status.mergeSummary(DiagnosticStatus::WARN, m.str());
   }
-  const double window_s = n > 1 ? std::max((window_.back().at - window_.front().at).toSec(), 1e-3) : 0.0;
-  status.add("input rate (Hz)", window_s > 0 ? (n - 1) / window_s : 0.0);
+  status.add("input rate (Hz)", window_.rateHz());
   status.add("trained (%, last 5 s)", percent(trained, n));
   status.add("rejected (%, last 5 s)", percent(rejected, n));
   status.add("without pose (%, last 5 s)", percent(no_pose, n));

@@ -1,6 +1,8 @@
 #include "act_color/ros/nodelet_setup.hpp"
 
+#include <algorithm>
 #include <exception>
+#include <initializer_list>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -81,12 +83,6 @@ const char* typeName(XmlRpc::XmlRpcValue::Type type) {
   }
 }
 
-// The parameter when set; *set false when it is not.
-bool fetch(const ros::NodeHandle& nh, const std::string& name, XmlRpc::XmlRpcValue* value, bool* set) {
-  *set = nh.hasParam(name) && nh.getParam(name, *value);
-  return *set;
-}
-
 bool wrongType(const std::string& name, XmlRpc::XmlRpcValue& value, const char* expected, std::string* error) {
   std::ostringstream s;
   s << "parameter ~" << name << " must be " << expected << ", is ";
@@ -100,47 +96,49 @@ bool wrongType(const std::string& name, XmlRpc::XmlRpcValue& value, const char* 
   return false;
 }
 
+// ~name read as T when set (true, *value unchanged, when it is not); `accepts` says which XmlRpc
+// types stand for a T.
+template <class T, class Cast>
+bool readTyped(const ros::NodeHandle& nh, const std::string& name,
+               std::initializer_list<XmlRpc::XmlRpcValue::Type> accepts, const char* expected, Cast cast, T* value,
+               std::string* error) {
+  XmlRpc::XmlRpcValue v;
+  if (!nh.hasParam(name) || !nh.getParam(name, v)) return true;
+  if (std::find(accepts.begin(), accepts.end(), v.getType()) == accepts.end()) {
+    return wrongType(name, v, expected, error);
+  }
+  *value = cast(v);
+  return true;
+}
+
 }  // namespace
 
 bool readParam(const ros::NodeHandle& nh, const std::string& name, double* value, std::string* error) {
-  XmlRpc::XmlRpcValue v;
-  bool set = false;
-  if (!fetch(nh, name, &v, &set)) return true;
-  if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
-    *value = static_cast<double>(v);
-  } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
-    *value = static_cast<int>(v);
-  } else {
-    return wrongType(name, v, "a number", error);
-  }
-  return true;
+  return readTyped(
+      nh, name, {XmlRpc::XmlRpcValue::TypeDouble, XmlRpc::XmlRpcValue::TypeInt}, "a number",
+      [](XmlRpc::XmlRpcValue& v) {
+        return v.getType() == XmlRpc::XmlRpcValue::TypeInt ? static_cast<double>(static_cast<int>(v))
+                                                           : static_cast<double>(v);
+      },
+      value, error);
 }
 
 bool readParam(const ros::NodeHandle& nh, const std::string& name, int* value, std::string* error) {
-  XmlRpc::XmlRpcValue v;
-  bool set = false;
-  if (!fetch(nh, name, &v, &set)) return true;
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeInt) return wrongType(name, v, "an integer", error);
-  *value = static_cast<int>(v);
-  return true;
+  return readTyped(
+      nh, name, {XmlRpc::XmlRpcValue::TypeInt}, "an integer",
+      [](XmlRpc::XmlRpcValue& v) { return static_cast<int>(v); }, value, error);
 }
 
 bool readParam(const ros::NodeHandle& nh, const std::string& name, bool* value, std::string* error) {
-  XmlRpc::XmlRpcValue v;
-  bool set = false;
-  if (!fetch(nh, name, &v, &set)) return true;
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) return wrongType(name, v, "true or false", error);
-  *value = static_cast<bool>(v);
-  return true;
+  return readTyped(
+      nh, name, {XmlRpc::XmlRpcValue::TypeBoolean}, "true or false",
+      [](XmlRpc::XmlRpcValue& v) { return static_cast<bool>(v); }, value, error);
 }
 
 bool readParam(const ros::NodeHandle& nh, const std::string& name, std::string* value, std::string* error) {
-  XmlRpc::XmlRpcValue v;
-  bool set = false;
-  if (!fetch(nh, name, &v, &set)) return true;
-  if (v.getType() != XmlRpc::XmlRpcValue::TypeString) return wrongType(name, v, "a string", error);
-  *value = static_cast<std::string&>(v);
-  return true;
+  return readTyped(
+      nh, name, {XmlRpc::XmlRpcValue::TypeString}, "a string",
+      [](XmlRpc::XmlRpcValue& v) { return static_cast<std::string&>(v); }, value, error);
 }
 
 }  // namespace ros_conversions

@@ -92,7 +92,7 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::string last_error_;
   // ... and of the last seconds.
   static constexpr double kWindowS = 5.0;
-  std::deque<Record> window_;
+  ros_conversions::RecentWindow<Record> window_{kWindowS};
   ros::WallTime last_image_, last_table_;
 };
 
@@ -349,8 +349,7 @@ void SegmentationNodelet::flush() {
 
 void SegmentationNodelet::record(TableUsed table, double classify_ms, double latency_ms) {
   const ros::WallTime now = ros::WallTime::now();
-  window_.push_back({now, table, classify_ms, latency_ms});
-  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+  window_.add({now, table, classify_ms, latency_ms});
 }
 
 double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut) {
@@ -427,7 +426,7 @@ void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
     return;
   }
   const ros::WallTime now = ros::WallTime::now();
-  while (!window_.empty() && (now - window_.front().at).toSec() > kWindowS) window_.pop_front();
+  window_.trim(now);
   size_t counts[5] = {0, 0, 0, 0, 0};
   double sum_ms = 0, max_ms = 0, sum_latency = 0, max_latency = 0;
   size_t classified = 0;
@@ -441,7 +440,7 @@ void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
     max_latency = std::max(max_latency, r.latency_ms);
   }
   const size_t n = window_.size();
-  auto percent = [](double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0.0; };
+  using ros_conversions::percent;
   const size_t exact = counts[static_cast<int>(TableUsed::kExact)];
   const size_t none = counts[static_cast<int>(TableUsed::kNone)];
   const size_t rejected = counts[static_cast<int>(TableUsed::kRejected)];
@@ -476,8 +475,7 @@ void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
       status.mergeSummary(rejected == n ? DiagnosticStatus::ERROR : DiagnosticStatus::WARN, m.str());
     }
   }
-  const double window_s = n > 1 ? std::max((window_.back().at - window_.front().at).toSec(), 1e-3) : 0.0;
-  status.add("label rate (Hz)", window_s > 0 ? (n - 1) / window_s : 0.0);
+  status.add("label rate (Hz)", window_.rateHz());
   status.add("with the table of the same frame (%, last 5 s)", percent(exact, n));
   status.add("with an older or the newest table (%, last 5 s)", percent(stale, n));
   status.add("without a table, all unknown (%, last 5 s)", percent(none, n));

@@ -57,6 +57,19 @@ bool readRegularFile(const std::string& path, size_t limit, std::vector<uint8_t>
   return true;
 }
 
+// True when the regular file at `path` begins with the magic line (reads only that).
+bool startsAsTableFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return false;
+  struct stat st {};
+  char head[kMagicBytes];
+  const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
+                  ::read(fd, head, kMagicBytes) == static_cast<ssize_t>(kMagicBytes) &&
+                  std::memcmp(head, kLutFileMagic, kMagicBytes) == 0;
+  ::close(fd);
+  return ok;
+}
+
 // Walks the serialized ColorLut (Header, color_space, bits, revision, table, clusters) checking
 // every length against what is left; "" when it is consistent.
 std::string checkLayout(const uint8_t* p, size_t size) {
@@ -102,15 +115,10 @@ bool saveLutFile(const act_color::ColorLut& msg, const std::string& path, std::s
   }
   std::error_code ec;
   const fs::file_status status = fs::symlink_status(path, ec);
-  if (fs::exists(status)) {
+  if (fs::exists(status) && !(fs::is_regular_file(status) && startsAsTableFile(path))) {
     // Replace only what is a table already.
-    std::vector<uint8_t> head;
-    std::string why;
-    if (!fs::is_regular_file(status) || !readRegularFile(path, kMaxLutFileBytes, &head, &why) ||
-        head.size() < kMagicBytes || std::memcmp(head.data(), kLutFileMagic, kMagicBytes) != 0) {
-      *error = "'" + path + "' exists and is not a color table file: not overwritten";
-      return false;
-    }
+    *error = "'" + path + "' exists and is not a color table file: not overwritten";
+    return false;
   }
   const uint32_t size = ::ros::serialization::serializationLength(msg);
   std::vector<uint8_t> buffer(kMagicBytes + size);

@@ -13,38 +13,21 @@
 #include "act_color/core/calibration.hpp"
 #include "act_color/sim/renderer.hpp"
 #include "act_color/sim/scene_family.hpp"
+#include "tool_test_util.hpp"
 
 namespace core = act_color::core;
 namespace sim = act_color::sim;
 
 namespace {
 
-std::string tempDir() {
-  static std::string dir;
-  if (dir.empty()) {
-    char pattern[] = "/tmp/act_calibrate_test_XXXXXX";
-    dir = mkdtemp(pattern);
-  }
-  return dir;
-}
+std::string tempDir() { return act_color_tool_test::tempDir("act_calibrate_test"); }
 
-struct ToolRun {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
-
+using act_color_tool_test::ToolRun;
 ToolRun run(const std::string& arguments) {
-  const std::string log = tempDir() + "/log.txt";
-  const std::string command = std::string(ACT_TOOLS_DIR) + "/act_calibrate " + arguments + " > " + log + " 2>&1";
-  const int status = std::system(command.c_str());
-  ToolRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream file(log);
-  r.output.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-  return r;
+  return act_color_tool_test::runTool("act_calibrate", arguments, tempDir());
 }
 
-bool exists(const std::string& path) { return static_cast<bool>(std::ifstream(path)); }
+using act_color_tool_test::exists;
 
 }  // namespace
 

@@ -21,6 +21,7 @@
 #include "act_color/ros/conversions.hpp"
 #include "act_color/ros/lut_file.hpp"
 #include "act_color/sim/real_image_suite.hpp"
+#include "tool_test_util.hpp"
 
 namespace core = act_color::core;
 namespace conv = act_color::ros_conversions;
@@ -30,32 +31,12 @@ namespace {
 const std::string kCalibration = std::string(ACT_SOURCE_DIR) + "/config/calibration/msl_2007_580.yaml";
 constexpr size_t kCells = 64 * 64 * 64;
 
-std::string tempDir() {
-  static std::string dir;
-  if (dir.empty()) {
-    char pattern[] = "/tmp/act_lut_test_XXXXXX";
-    dir = mkdtemp(pattern);
-  }
-  return dir;
-}
+std::string tempDir() { return act_color_tool_test::tempDir("act_lut_test"); }
 
-struct ToolRun {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr
-};
+using act_color_tool_test::ToolRun;
+ToolRun run(const std::string& arguments) { return act_color_tool_test::runTool("act_lut", arguments, tempDir()); }
 
-ToolRun run(const std::string& arguments) {
-  const std::string log = tempDir() + "/log.txt";
-  const std::string command = std::string(ACT_TOOLS_DIR) + "/act_lut " + arguments + " > " + log + " 2>&1";
-  const int status = std::system(command.c_str());
-  ToolRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream file(log);
-  r.output.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-  return r;
-}
-
-bool exists(const std::string& path) { return static_cast<bool>(std::ifstream(path)); }
+using act_color_tool_test::exists;
 
 std::vector<uint8_t> readBytes(const std::string& path) {
   std::ifstream file(path, std::ios::binary);

@@ -19,6 +19,7 @@
 #include "act_color/ColorLut.h"
 #include "act_color/core/calibration.hpp"
 #include "act_color/ros/bag_replay.hpp"
+#include "tool_test_util.hpp"
 
 using act_color::ros_layer::ReplayError;
 using act_color::ros_layer::ReplayOptions;
@@ -28,14 +29,7 @@ namespace {
 
 const std::string kCalibration = std::string(ACT_SOURCE_DIR) + "/config/calibration/msl_2007_580.yaml";
 
-std::string tempDir() {
-  static std::string dir;
-  if (dir.empty()) {
-    char pattern[] = "/tmp/act_replay_test_XXXXXX";
-    dir = mkdtemp(pattern);
-  }
-  return dir;
-}
+std::string tempDir() { return act_color_tool_test::tempDir("act_replay_test"); }
 
 // The small scenario bag, written once per test run.
 std::string scenarioBag(const std::string& name) {
@@ -48,16 +42,13 @@ std::string scenarioBag(const std::string& name) {
   return bag;
 }
 
-std::string readBytes(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-}
+using act_color_tool_test::readText;
 
 // Runs a shell command with stdout and stderr into *output; returns its exit status.
 int run(const std::string& command, std::string* output) {
   const std::string file = tempDir() + "/command_output.txt";
   const int status = std::system((command + " > " + file + " 2>&1").c_str());
-  *output = readBytes(file);
+  *output = readText(file);
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
@@ -194,12 +185,12 @@ TEST(ActReplay, SameInputSameOutputBytes) {
                            " --bag " + in + " --output ";
   ASSERT_EQ(std::system((tool + tempDir() + "/a.bag > /dev/null").c_str()), 0);
   ASSERT_EQ(std::system((tool + tempDir() + "/b.bag > /dev/null").c_str()), 0);
-  const std::string a = readBytes(tempDir() + "/a.bag");
+  const std::string a = readText(tempDir() + "/a.bag");
   EXPECT_GT(a.size(), 1000000u);
-  EXPECT_TRUE(a == readBytes(tempDir() + "/b.bag"));
+  EXPECT_TRUE(a == readText(tempDir() + "/b.bag"));
   // Another seed gives other random start pixels, hence another table.
   ASSERT_EQ(std::system((tool + tempDir() + "/c.bag --seed 7 > /dev/null").c_str()), 0);
-  EXPECT_FALSE(a == readBytes(tempDir() + "/c.bag"));
+  EXPECT_FALSE(a == readText(tempDir() + "/c.bag"));
 }
 
 TEST(ActReplay, ClearErrorsForUnusableInput) {
@@ -435,7 +426,7 @@ TEST(ActReplay, TruncatedBagSuggestsReindex) {
 TEST(ActReplay, CorruptChunkLeavesNoPartialOutput) {
   const std::string in = tempDir() + "/corrupt_chunk.bag";
   copyBag(scenarioBag("static_darkening"), in, 10, kUnchanged, /*images_last=*/true);
-  std::string bytes = readBytes(in);
+  std::string bytes = readText(in);
   const std::string field = "compression=none";
   const size_t last_chunk = bytes.rfind(field);
   ASSERT_NE(last_chunk, std::string::npos);

@@ -19,20 +19,14 @@
 #include "act_color/ros/conversions.hpp"
 #include "act_color/ros/lut_file.hpp"
 #include "act_color/sim/flat_painter.hpp"
+#include "tool_test_util.hpp"
 
 namespace {
 
 namespace core = act_color::core;
 namespace conv = act_color::ros_conversions;
 
-std::string scratch() {
-  static std::string dir;
-  if (dir.empty()) {
-    char pattern[] = "/tmp/act_lut_file_test_XXXXXX";
-    dir = mkdtemp(pattern);
-  }
-  return dir;
-}
+std::string scratch() { return act_color_tool_test::tempDir("act_lut_file_test"); }
 
 std::vector<uint8_t> bytesOf(const std::string& path) {
   std::ifstream file(path, std::ios::binary);

@@ -3,6 +3,8 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <ros/ros.h>
 
+#include <algorithm>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -13,22 +15,20 @@
 // rosconsole's *_THROTTLE runs on ROS time, so with a stopped /clock (a paused bag) it prints once
 // and then never, and after the clock jumps back it stays silent until the clock has caught up.
 //   ACT_WALL_THROTTLE(5.0, NODELET_WARN("image rejected: %s", why.c_str()));
-#define ACT_WALL_THROTTLE(period, ...)                                              \
-  do {                                                                              \
-    static double act_last_hit_s_ = -1e300;                                         \
-    const double act_now_s_ = ::ros::WallTime::now().toSec();                       \
-    if (act_now_s_ - act_last_hit_s_ >= (period) || act_now_s_ < act_last_hit_s_) { \
-      act_last_hit_s_ = act_now_s_;                                                 \
-      __VA_ARGS__;                                                                  \
-    }                                                                               \
+#define ACT_WALL_THROTTLE(period, ...)                                                                   \
+  do {                                                                                                   \
+    static const std::string act_throttle_key_ = std::string(__FILE__) + ":" + std::to_string(__LINE__); \
+    if (::act_color::ros_conversions::wallThrottle(act_throttle_key_, (period))) {                       \
+      __VA_ARGS__;                                                                                       \
+    }                                                                                                    \
   } while (false)
 
 namespace act_color {
 namespace ros_conversions {
 
 // A wall-time throttle per key (thread-safe): true at most once per `period_s` for each key, so
-// that one kind of bad input does not hide another. Keys are kinds of messages, e.g. a message's
-// text up to its first number (keyOf).
+// that one kind of bad input does not hide another. Keys are call sites (ACT_WALL_THROTTLE) or kinds
+// of messages, e.g. a message's text up to its first number (keyOf).
 bool wallThrottle(const std::string& key, double period_s);
 std::string keyOf(const std::string& message);
 
@@ -54,6 +54,38 @@ bool readParam(const ros::NodeHandle& nh, const std::string& name, double* value
 bool readParam(const ros::NodeHandle& nh, const std::string& name, int* value, std::string* error);
 bool readParam(const ros::NodeHandle& nh, const std::string& name, bool* value, std::string* error);
 bool readParam(const ros::NodeHandle& nh, const std::string& name, std::string* value, std::string* error);
+
+// A nodelet's records of the last `window_s` seconds of wall time, for diagnostics. R has a
+// member `ros::WallTime at`.
+template <class R>
+class RecentWindow {
+ public:
+  explicit RecentWindow(double window_s) : window_s_(window_s) {}
+  void add(const R& r) {
+    items_.push_back(r);
+    trim(r.at);
+  }
+  void trim(const ros::WallTime& now) {
+    while (!items_.empty() && (now - items_.front().at).toSec() > window_s_) items_.pop_front();
+  }
+  void clear() { items_.clear(); }
+  size_t size() const { return items_.size(); }
+  typename std::deque<R>::const_iterator begin() const { return items_.begin(); }
+  typename std::deque<R>::const_iterator end() const { return items_.end(); }
+  // Records per second over the span they cover; 0 with fewer than two.
+  double rateHz() const {
+    if (items_.size() < 2) return 0.0;
+    return (items_.size() - 1) / std::max((items_.back().at - items_.front().at).toSec(), 1e-3);
+  }
+  double seconds() const { return window_s_; }
+
+ private:
+  double window_s_;
+  std::deque<R> items_;
+};
+
+// 100 * part / whole; 0 when whole is 0.
+inline double percent(double part, double whole) { return whole > 0 ? 100.0 * part / whole : 0.0; }
 
 // Notices a stamp going back by more than a second (a bag played again, `rosbag play -l`, a
 // restarted simulation): what depends on time must then start afresh.
