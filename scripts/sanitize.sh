@@ -7,14 +7,22 @@
 # hidden by the tests that run them) and are printed at the end; the last line is a summary.
 #   scripts/sanitize.sh          test_core, test_feature_extractor, test_tools
 #   scripts/sanitize.sh --all    and test_sim (slow; its timing test is left out)
+#   scripts/sanitize.sh --ros    the core tests, then every rostest (test/ros) with the nodelets,
+#                                the test nodes and the tools instrumented; the nodelet manager
+#                                (a system binary) gets the ASan runtime preloaded. Leak detection
+#                                is off there: roscpp's and Python's own allocations at exit are
+#                                not ours to fix; every other finding halts the process.
 # ACT_SANITIZE_WS chooses the workspace (default: ws-sanitize-* beside the normal one).
 set -eo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 tests=(test_core test_feature_extractor test_tools)
+ros=0
+targets=()
 case "${1:-}" in
   "") ;;
   --all) tests+=(test_sim) ;;
-  *) echo "usage: $0 [--all]" >&2; exit 2 ;;
+  --ros) ros=1; targets=(tests) ;;
+  *) echo "usage: $0 [--all | --ros]" >&2; exit 2 ;;
 esac
 start=$(date +%s)
 ACT_WS=${ACT_SANITIZE_WS:-${XDG_CACHE_HOME:-$HOME/.cache}/act_color/ws-sanitize-$(echo "$ACT_ROOT" | md5sum | cut -c1-8)}
@@ -31,7 +39,7 @@ mkdir -p "$ACT_WS/src"
 ln -sfn "$ACT_ROOT" "$ACT_WS/src/act_color"
 log="$ACT_WS/build.log"
 echo "act_color: building ${tests[*]} with $flags in $ACT_WS"
-if ! catkin_make -C "$ACT_WS" -j"$(nproc)" "${tests[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+if ! catkin_make -C "$ACT_WS" -j"$(nproc)" "${tests[@]}" "${targets[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     "-DCMAKE_CXX_FLAGS=$cxx_flags" "-DCMAKE_EXE_LINKER_FLAGS=$flags" "-DCMAKE_SHARED_LINKER_FLAGS=$flags" \
     -DPYTHON_EXECUTABLE=/usr/bin/python3 -DPython3_EXECUTABLE=/usr/bin/python3 >"$log" 2>&1; then
   tail -n 80 "$log"
@@ -65,6 +73,25 @@ for t in "${tests[@]}"; do
   summary+=("$t $status $(($(date +%s) - t0))s")
   grep -E '^\[  (PASSED|FAILED) ' "$reports/$t.out" | sed 's/^/  /' || true
 done
+
+if [ $ros = 1 ]; then
+  # The rostests as CTest runs them (their arguments, e.g. the test bags), every process under
+  # the sanitizers: the instrumented libraries need the ASan runtime first in the process.
+  t0=$(date +%s)
+  echo "act_color: running the rostests under ASan+UBSan"
+  asan_runtime=$(gcc -print-file-name=libasan.so)
+  if (cd "$ACT_WS/build" && LD_PRELOAD="$asan_runtime" \
+      ASAN_OPTIONS="detect_leaks=0:halt_on_error=1:log_path=$reports/asan" \
+      ctest -R '^_ctest_act_color_rostest_' --output-on-failure) >"$reports/rostests.out" 2>&1; then
+    status=ok
+  else
+    status="exit $?"
+    failed+=(rostests)
+  fi
+  tests+=(rostests)
+  summary+=("rostests $status $(($(date +%s) - t0))s")
+  grep -E 'tests passed|Passed|Failed|\*\*\*' "$reports/rostests.out" | sed 's/^/  /' || true
+fi
 
 shopt -s nullglob
 files=("$reports"/asan.* "$reports"/ubsan.*)

@@ -61,7 +61,12 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   };
 
   void onInit() override;
+  // The parameters, topics, services and timers, on the manager's load path (fast); the
+  // calibration and what is built from it follow in loadCalibration, on loader_'s thread.
   bool configure(std::string* error);
+  void loadCalibration(const core::ActParams& params, const std::string& load_path);
+  // Why there is no trainer: the calibration is still loading, or the reason it failed.
+  std::string notReady() const;
   bool readParams(core::ActParams* params, std::string* error);
   void onImage(const sensor_msgs::ImageConstPtr& msg);
   // Trains the waiting images in order, as far as their poses have come (or waited ~tf_timeout).
@@ -93,11 +98,13 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   image_transport::Publisher classified_pub_, expected_pub_;
   ros::Publisher lut_pub_, lut_throttled_pub_, debug_pub_, ball_pub_, pose_pub_, table_image_pub_, field_pub_;
   std::string base_frame_, field_frame_;
-  ros::ServiceServer save_srv_, load_srv_;
   // The services' file I/O runs on a queue and thread of its own: a slow or stuck file system never
-  // holds up training (the image callbacks' queue).
+  // holds up training (the image callbacks' queue). The queue is declared before the servers on
+  // it: a server removes its callbacks from the queue when it goes (unloading the nodelet crashed
+  // the manager when the queue went first).
   ros::CallbackQueue io_queue_;
   std::unique_ptr<ros::AsyncSpinner> io_spinner_;
+  ros::ServiceServer save_srv_, load_srv_;
   std::unique_ptr<ros_conversions::CheckedReconfigure<ActTrainerConfig>> reconfigure_;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   ros::WallTimer diagnostics_timer_, drain_timer_, table_image_timer_;
@@ -106,6 +113,7 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   // Everything below is guarded by mutex_.
   mutable std::mutex mutex_;
   std::string config_error_;  // non-empty: the nodelet could not be configured and does nothing
+  bool loading_ = false;      // the calibration is being loaded (trainer_ follows)
   std::unique_ptr<core::ActTrainer> trainer_;
   std::unique_ptr<core::Segmenter> segmenter_;
   core::ActParams params_;
@@ -145,11 +153,16 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   ros_conversions::RecentWindow<Record> window_{kWindowS};
   std::deque<std::pair<ros::WallTime, uint64_t>> fill_history_;  // filled cells, once per diagnostics
   ros::WallTime last_image_;
+  ros_conversions::BackgroundTask loader_;
 };
 
 ActTrainerNodelet::~ActTrainerNodelet() {
+  // A calibration still loading finishes first (its size is bounded, see core::loadCalibration).
+  loader_.wait();
   // No service call may run into a half-destroyed nodelet.
   if (io_spinner_) io_spinner_->stop();
+  save_srv_.shutdown();
+  load_srv_.shutdown();
   // ~save_on_shutdown: the table of this run survives the robot's restart. Never throws.
   try {
     std::string path, message;
@@ -220,10 +233,6 @@ bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) 
 
 bool ActTrainerNodelet::configure(std::string* error) {
   using ros_conversions::readParam;
-  core::Calibration calibration;
-  std::string calibration_path;
-  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, error)) return false;
-
   core::ActParams params;
   if (!readParams(&params, error)) return false;
   // Extensions removed because the randomized scene family showed they did not help (issue 11):
@@ -278,14 +287,9 @@ bool ActTrainerNodelet::configure(std::string* error) {
     return false;
   }
   if (!pose_source_.init(nh_, pnh_, getName(), error)) return false;
-  // A pose off the carpet by more than a metre is a localization failure, not a place to train at.
-  pose_source_.setFieldBounds(0.5 * calibration.field.length_m + calibration.field.margin_m + 1.0,
-                              0.5 * calibration.field.width_m + calibration.field.margin_m + 1.0);
 
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    trainer_ = std::make_unique<core::ActTrainer>(calibration, params);
-    segmenter_ = std::make_unique<core::Segmenter>(calibration.camera);
     params_ = params;
     bootstrap_cycles_ = bootstrap_cycles;
     bootstrap_at_first_pose_ = bootstrap_at_first_pose;
@@ -305,14 +309,6 @@ bool ActTrainerNodelet::configure(std::string* error) {
     c.publish_lut_every = node_config.publish_lut_every;
     c.lut_throttled_period = node_config.lut_throttled_period;
     if (!applyConfig(c, error)) return false;
-  }
-  if (!load_path.empty()) {
-    std::string message;
-    if (loadLut(load_path, &message)) {
-      NODELET_INFO("%s", message.c_str());
-    } else {
-      NODELET_ERROR("~load_lut: %s; starting without a table", message.c_str());
-    }
   }
 
   // The table is published as an immutable shared message: in the same manager, subscribers get
@@ -342,7 +338,6 @@ bool ActTrainerNodelet::configure(std::string* error) {
     }
   });
   field_pub_ = nh_.advertise<visualization_msgs::MarkerArray>("field_markers", 1, true);
-  publishFieldMarkers(core::FieldModel(calibration.field));
   {
     ros::NodeHandle io(pnh_);
     io.setCallbackQueue(&io_queue_);
@@ -372,14 +367,69 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // A few frames of slack (as the segmentation): a slow cycle, or a busy machine replaying a bag,
   // does not drop frames at once.
   image_sub_ = it_->subscribe("image", 5, &ActTrainerNodelet::onImage, this, hints);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    loading_ = true;
+  }
+  loader_.start([this, params, load_path] { loadCalibration(params, load_path); },
+                [this](const std::string& e) {
+                  NODELET_ERROR("not started: %s", e.c_str());
+                  std::lock_guard<std::mutex> lock(mutex_);
+                  config_error_ = e;
+                  loading_ = false;
+                });
+  return true;
+}
+
+void ActTrainerNodelet::loadCalibration(const core::ActParams& params, const std::string& load_path) {
+  core::Calibration calibration;
+  std::string calibration_path, error;
+  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, &error)) {
+    NODELET_ERROR("not started: %s", error.c_str());
+    std::lock_guard<std::mutex> lock(mutex_);
+    config_error_ = error;
+    loading_ = false;
+    return;
+  }
+  // A pose off the carpet by more than a metre is a localization failure, not a place to train at.
+  pose_source_.setFieldBounds(0.5 * calibration.field.length_m + calibration.field.margin_m + 1.0,
+                              0.5 * calibration.field.width_m + calibration.field.margin_m + 1.0);
+  // The camera model of every pixel: the part that grows with the image.
+  auto trainer = std::make_unique<core::ActTrainer>(calibration, params);
+  auto segmenter = std::make_unique<core::Segmenter>(calibration.camera);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    trainer_ = std::move(trainer);
+    segmenter_ = std::move(segmenter);
+    loading_ = false;
+    params_changed_ = true;  // ~dynamic_reconfigure may have changed them while loading
+  }
+  if (!load_path.empty()) {
+    std::string message;
+    if (loadLut(load_path, &message)) {
+      NODELET_INFO("%s", message.c_str());
+    } else {
+      NODELET_ERROR("~load_lut: %s; starting without a table", message.c_str());
+    }
+  }
+  publishFieldMarkers(core::FieldModel(calibration.field));
+  bool has_table = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    has_table = has_table_;
+  }
   NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s", calibration_path.c_str(),
                calibration.camera.width, calibration.camera.height,
                pose_source_.mode() == ros_conversions::PoseSource::Mode::kTf ? "tf" : "topic",
-               has_table_                 ? "loaded"
+               has_table                  ? "loaded"
                : initial_pose_            ? "bootstrap at ~initial_pose"
                : bootstrap_at_first_pose_ ? "bootstrap at the first localization pose"
                                           : "none (trained online)");
-  return true;
+}
+
+std::string ActTrainerNodelet::notReady() const {
+  if (loading_) return "the calibration is still loading";
+  return "the nodelet is not configured: " + config_error_;
 }
 
 ActTrainerConfig ActTrainerNodelet::configInEffect() const {
@@ -463,12 +513,18 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
 void ActTrainerNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
   try {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!trainer_) return;
+    if (!trainer_ && !loading_) return;
     const ros::Time before = image_time_.latest();
     if (image_time_.jumpedBack(msg->header.stamp)) onTimeJump(before, msg->header.stamp);
     ++images_;
     last_image_ = ros::WallTime::now();
     pending_.push_back({msg, last_image_});
+    if (!trainer_) {
+      // Images wait for the calibration as they wait for their pose, the oldest dropped.
+      if (pending_.size() > kMaxPending) pending_.pop_front();
+      ACT_WALL_THROTTLE(2.0, NODELET_INFO("image waits: the calibration is still loading"));
+      return;
+    }
     drain();
   } catch (const std::exception& e) {
     ACT_WALL_THROTTLE(5.0, NODELET_ERROR("image stamped %.3f: %s", msg->header.stamp.toSec(), e.what()));
@@ -476,6 +532,7 @@ void ActTrainerNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
 }
 
 void ActTrainerNodelet::drain() {
+  if (!trainer_) return;  // the calibration is still loading
   while (!pending_.empty()) {
     const Pending& front = pending_.front();
     const bool may_wait =
@@ -734,7 +791,7 @@ bool ActTrainerNodelet::saveLut(const std::string& requested, std::string* messa
     std::lock_guard<std::mutex> lock(mutex_);
     if (!ros_conversions::lutPathInside(lut_dir_, requested, &path, message)) return false;
     if (!trainer_ || !has_table_) {
-      *message = trainer_ ? "no table trained yet" : "the nodelet is not configured: " + config_error_;
+      *message = trainer_ ? "no table trained yet" : notReady();
       return false;
     }
     std_msgs::Header header;
@@ -766,7 +823,7 @@ bool ActTrainerNodelet::loadLut(const std::string& requested, std::string* messa
   }
   std::lock_guard<std::mutex> lock(mutex_);
   if (!trainer_) {
-    *message = "the nodelet is not configured: " + config_error_;
+    *message = notReady();
     return false;
   }
   if (camera_format_ && lut.colorSpace() != core::nativeColorSpace(*camera_format_)) {
@@ -854,6 +911,11 @@ bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& re
 void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
+  if (loading_) {
+    status.summary(DiagnosticStatus::WARN, "loading the calibration");
+    status.add("images waiting", pending_.size());
+    return;
+  }
   if (!config_error_.empty() || !trainer_) {
     status.summary(DiagnosticStatus::ERROR, "not configured: " + config_error_);
     return;

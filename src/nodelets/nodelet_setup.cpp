@@ -46,6 +46,19 @@ std::string runConfigure(const std::function<bool(std::string*)>& configure) {
   return error.empty() ? "configuration failed" : error;
 }
 
+void BackgroundTask::start(std::function<void()> work, std::function<void(const std::string&)> on_error) {
+  wait();
+  thread_ = std::thread([work = std::move(work), on_error = std::move(on_error)] {
+    try {
+      work();
+    } catch (const std::exception& e) {
+      on_error(e.what());
+    } catch (...) {
+      on_error("unknown exception");
+    }
+  });
+}
+
 bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,
                           std::string* error) {
   if (!readParam(pnh, "calibration", path, error)) return false;

@@ -46,8 +46,12 @@ class SegmentationNodelet : public nodelet::Nodelet {
     double latency_ms;  // image stamp to labels (ROS time)
   };
 
+  ~SegmentationNodelet() override { loader_.wait(); }
   void onInit() override;
+  // Parameters, topics and timers on the manager's load path; the calibration and the camera
+  // model follow in loadCalibration, on loader_'s thread (images are dropped until then).
   bool configure(std::string* error);
+  void loadCalibration();
   bool applyConfig(const SegmentationConfig& config, std::string* error);
   void connectCb();
   void onImage(const sensor_msgs::ImageConstPtr& msg);
@@ -94,6 +98,8 @@ class SegmentationNodelet : public nodelet::Nodelet {
   static constexpr double kWindowS = 5.0;
   ros_conversions::RecentWindow<Record> window_{kWindowS};
   ros::WallTime last_image_, last_table_;
+  bool loading_ = false;  // the calibration is being loaded (segmenter_, camera_ and field_ follow)
+  ros_conversions::BackgroundTask loader_;
 };
 
 void SegmentationNodelet::onInit() {
@@ -112,9 +118,6 @@ void SegmentationNodelet::onInit() {
 
 bool SegmentationNodelet::configure(std::string* error) {
   using ros_conversions::readParam;
-  core::Calibration calibration;
-  std::string calibration_path;
-  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, error)) return false;
   SegmentationConfig c = SegmentationConfig::__getDefault__();
   bool lazy = false, debug = false;
   if (!readParam(pnh_, "queue_size", &c.queue_size, error) || !readParam(pnh_, "max_wait", &c.max_wait, error) ||
@@ -130,14 +133,8 @@ bool SegmentationNodelet::configure(std::string* error) {
     return false;
   }
   if (!pose_source_.init(nh_, pnh_, getName(), error)) return false;
-  // A pose off the carpet by more than a metre is a localization failure, not a place to train at.
-  pose_source_.setFieldBounds(0.5 * calibration.field.length_m + calibration.field.margin_m + 1.0,
-                              0.5 * calibration.field.width_m + calibration.field.margin_m + 1.0);
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    camera_ = std::make_unique<core::OmniCameraModel>(calibration.camera);
-    segmenter_ = std::make_unique<core::Segmenter>(calibration.camera);
-    field_ = calibration.field;
     lazy_ = lazy;
     debug_addresses_ = debug;
   }
@@ -166,9 +163,48 @@ bool SegmentationNodelet::configure(std::string* error) {
     }
   });
   connectCb();
-  NODELET_INFO("segmentation ready: calibration %s, %s", calibration_path.c_str(),
-               lazy_ ? "inputs subscribed while someone listens" : "always subscribed");
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    loading_ = true;
+  }
+  loader_.start([this] { loadCalibration(); },
+                [this](const std::string& e) {
+                  NODELET_ERROR("not started: %s", e.c_str());
+                  std::lock_guard<std::mutex> lock(mutex_);
+                  config_error_ = e;
+                  loading_ = false;
+                });
   return true;
+}
+
+void SegmentationNodelet::loadCalibration() {
+  core::Calibration calibration;
+  std::string calibration_path, error;
+  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, &error)) {
+    NODELET_ERROR("not started: %s", error.c_str());
+    std::lock_guard<std::mutex> lock(mutex_);
+    config_error_ = error;
+    loading_ = false;
+    return;
+  }
+  // A pose off the carpet by more than a metre is a localization failure, not a place to train at.
+  pose_source_.setFieldBounds(0.5 * calibration.field.length_m + calibration.field.margin_m + 1.0,
+                              0.5 * calibration.field.width_m + calibration.field.margin_m + 1.0);
+  auto camera = std::make_unique<core::OmniCameraModel>(calibration.camera);
+  auto segmenter = std::make_unique<core::Segmenter>(calibration.camera);
+  bool lazy = false;
+  {
+    // Set once: images are queued only while segmenter_ is set, so the processing outside the lock
+    // sees all three.
+    std::lock_guard<std::mutex> lock(mutex_);
+    camera_ = std::move(camera);
+    segmenter_ = std::move(segmenter);
+    field_ = calibration.field;
+    loading_ = false;
+    lazy = lazy_;
+  }
+  NODELET_INFO("segmentation ready: calibration %s, %s", calibration_path.c_str(),
+               lazy ? "inputs subscribed while someone listens" : "always subscribed");
 }
 
 bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* error) {
@@ -228,7 +264,10 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
   try {
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (!segmenter_) return;
+      if (!segmenter_) {
+        if (loading_) ACT_WALL_THROTTLE(2.0, NODELET_INFO("image dropped: the calibration is still loading"));
+        return;
+      }
       const ros::Time before = image_time_.latest();
       if (image_time_.jumpedBack(msg->header.stamp)) {
         // A new replay: the old run's tables are stamped in this run's future and would be taken
@@ -421,6 +460,10 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
 void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
+  if (loading_) {
+    status.summary(DiagnosticStatus::WARN, "loading the calibration");
+    return;
+  }
   if (!config_error_.empty() || !segmenter_) {
     status.summary(DiagnosticStatus::ERROR, "not configured: " + config_error_);
     return;

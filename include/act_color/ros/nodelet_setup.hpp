@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <thread>
 
 #include "act_color/core/calibration.hpp"
 
@@ -42,6 +43,26 @@ std::unique_ptr<diagnostic_updater::Updater> makeDiagnostics(
 // else the reason. A nodelet that fails stays loaded and harmless: one that throws or exits takes
 // its whole manager with it.
 std::string runConfigure(const std::function<bool(std::string*)>& configure);
+
+// Work that may take long (a large calibration file, the camera model of a large image) off the
+// nodelet manager's load path: onInit returns at once and the manager goes on loading the other
+// nodelets while `work` runs on a thread of its own. `work` reports its own errors (an exception
+// is caught and passed to `on_error`). The owner calls wait() first in its destructor, before the
+// members the work uses go.
+class BackgroundTask {
+ public:
+  BackgroundTask() = default;
+  BackgroundTask(const BackgroundTask&) = delete;
+  BackgroundTask& operator=(const BackgroundTask&) = delete;
+  ~BackgroundTask() { wait(); }
+  void start(std::function<void()> work, std::function<void(const std::string&)> on_error);
+  void wait() {
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  std::thread thread_;
+};
 
 // The calibration file named by ~calibration (its path in *path). False with the reason.
 bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,

@@ -1,0 +1,86 @@
+// Issue 15, item 2: loading a calibration happens off the nodelet manager's load path. The test
+// loads the trainer with a 16 Mpx calibration (its camera model takes about 2 s to build) through
+// the manager's load service and asks it for its table at once: it must answer that the
+// calibration is still loading (with the calibration loaded inside onInit, the load call would
+// only have returned once the trainer was ready). Unloading nodelets while they load must leave
+// the manager running.
+#include <gtest/gtest.h>
+#include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
+#include <ros/ros.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "act_color/FilePath.h"
+
+namespace {
+
+bool load(const std::string& name, const std::string& type) {
+  nodelet::NodeletLoad srv;
+  srv.request.name = name;
+  srv.request.type = type;
+  return ros::service::call("/load_manager/load_nodelet", srv) && srv.response.success;
+}
+
+bool unload(const std::string& name) {
+  nodelet::NodeletUnload srv;
+  srv.request.name = name;
+  return ros::service::call("/load_manager/unload_nodelet", srv) && srv.response.success;
+}
+
+// The trainer's answer to ~save_lut, or "" when the service did not answer.
+std::string saveAnswer(const std::string& trainer) {
+  act_color::FilePath srv;
+  srv.request.path = "load_path_test.lut";
+  if (!ros::service::call(trainer + "/save_lut", srv)) return "";
+  return srv.response.message;
+}
+
+double since(const std::chrono::steady_clock::time_point& t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+TEST(LoadPath, CalibrationLoadsOffTheManagersLoadPath) {
+  ASSERT_TRUE(ros::service::waitForService("/load_manager/load_nodelet", ros::Duration(30.0)));
+  const auto start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(load("/big/trainer", "act_color/act_trainer"));
+  const double load_call_s = since(start);
+  ASSERT_TRUE(ros::service::waitForService("/big/trainer/save_lut", ros::Duration(10.0)));
+  const std::string first = saveAnswer("/big/trainer");
+  const double first_answer_s = since(start);
+  // Then it becomes ready: it has no table yet.
+  std::string answer = first;
+  while (answer.find("no table trained yet") == std::string::npos && since(start) < 60.0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    answer = saveAnswer("/big/trainer");
+  }
+  const double ready_s = since(start);
+  std::printf("load_nodelet returned after %.3f s; ~save_lut at %.3f s: '%s'; ready after %.3f s: '%s'\n", load_call_s,
+              first_answer_s, first.c_str(), ready_s, answer.c_str());
+  EXPECT_NE(first.find("the calibration is still loading"), std::string::npos) << first;
+  EXPECT_NE(answer.find("no table trained yet"), std::string::npos) << answer;
+  EXPECT_LT(load_call_s, ready_s);
+
+  // Unloaded while loading: the nodelet waits for its loader, the manager keeps running.
+  ASSERT_TRUE(load("/big/trainer2", "act_color/act_trainer"));
+  EXPECT_TRUE(unload("/big/trainer2"));
+  ASSERT_TRUE(load("/big/segmentation", "act_color/segmentation"));
+  EXPECT_TRUE(unload("/big/segmentation"));
+  EXPECT_NE(saveAnswer("/big/trainer").find("no table trained yet"), std::string::npos);
+  EXPECT_TRUE(unload("/big/trainer"));
+  // The manager still loads nodelets.
+  ASSERT_TRUE(load("/big/segmentation", "act_color/segmentation"));
+  EXPECT_TRUE(unload("/big/segmentation"));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_load_path");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
