@@ -67,6 +67,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   void loadCalibration(const core::ActParams& params, const std::string& load_path);
   // Why there is no trainer: the calibration is still loading, or the reason it failed.
   std::string notReady() const;
+  // The nodelet could not be configured: it stays loaded and does nothing, saying why.
+  void notStarted(const std::string& error);
   bool readParams(core::ActParams* params, std::string* error);
   void onImage(const sensor_msgs::ImageConstPtr& msg);
   // Trains the waiting images in order, as far as their poses have come (or waited ~tf_timeout).
@@ -188,11 +190,14 @@ void ActTrainerNodelet::onInit() {
       nh_, pnh_, getName(), "ACT trainer", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
       &diagnostics_timer_);
   const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
-  if (!error.empty()) {
-    NODELET_ERROR("not started: %s", error.c_str());
-    std::lock_guard<std::mutex> lock(mutex_);
-    config_error_ = error;
-  }
+  if (!error.empty()) notStarted(error);
+}
+
+void ActTrainerNodelet::notStarted(const std::string& error) {
+  NODELET_ERROR("not started: %s", error.c_str());
+  std::lock_guard<std::mutex> lock(mutex_);
+  config_error_ = error;
+  loading_ = false;
 }
 
 bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) {
@@ -372,28 +377,13 @@ bool ActTrainerNodelet::configure(std::string* error) {
     loading_ = true;
   }
   loader_.start([this, params, load_path] { loadCalibration(params, load_path); },
-                [this](const std::string& e) {
-                  NODELET_ERROR("not started: %s", e.c_str());
-                  std::lock_guard<std::mutex> lock(mutex_);
-                  config_error_ = e;
-                  loading_ = false;
-                });
+                [this](const std::string& e) { notStarted(e); });
   return true;
 }
 
 void ActTrainerNodelet::loadCalibration(const core::ActParams& params, const std::string& load_path) {
-  core::Calibration calibration;
-  std::string calibration_path, error;
-  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, &error)) {
-    NODELET_ERROR("not started: %s", error.c_str());
-    std::lock_guard<std::mutex> lock(mutex_);
-    config_error_ = error;
-    loading_ = false;
-    return;
-  }
-  // A pose off the carpet by more than a metre is a localization failure, not a place to train at.
-  pose_source_.setFieldBounds(0.5 * calibration.field.length_m + calibration.field.margin_m + 1.0,
-                              0.5 * calibration.field.width_m + calibration.field.margin_m + 1.0);
+  std::string calibration_path;
+  const core::Calibration calibration = ros_conversions::loadCalibrationParam(pnh_, &pose_source_, &calibration_path);
   // The camera model of every pixel: the part that grows with the image.
   auto trainer = std::make_unique<core::ActTrainer>(calibration, params);
   auto segmenter = std::make_unique<core::Segmenter>(calibration.camera);

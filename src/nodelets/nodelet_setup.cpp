@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <stdexcept>
 
 namespace act_color {
 namespace ros_conversions {
@@ -59,20 +60,19 @@ void BackgroundTask::start(std::function<void()> work, std::function<void(const 
   });
 }
 
-bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,
-                          std::string* error) {
-  if (!readParam(pnh, "calibration", path, error)) return false;
-  if (path->empty()) {
-    *error = "parameter ~calibration (path of the calibration file) is not set";
-    return false;
-  }
+core::Calibration loadCalibrationParam(const ros::NodeHandle& pnh, PoseSource* pose_source, std::string* path) {
+  std::string error;
+  if (!readParam(pnh, "calibration", path, &error)) throw std::runtime_error(error);
+  if (path->empty()) throw std::runtime_error("parameter ~calibration (path of the calibration file) is not set");
+  core::Calibration calibration;
   try {
-    *calibration = core::loadCalibration(*path);
+    calibration = core::loadCalibration(*path);
   } catch (const std::exception& e) {
-    *error = std::string("bad calibration: ") + e.what();
-    return false;
+    throw std::runtime_error(std::string("bad calibration: ") + e.what());
   }
-  return true;
+  const core::FieldCalibration& f = calibration.field;
+  pose_source->setFieldBounds(0.5 * f.length_m + f.margin_m + 1.0, 0.5 * f.width_m + f.margin_m + 1.0);
+  return calibration;
 }
 
 namespace {

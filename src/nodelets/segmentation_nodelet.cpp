@@ -52,6 +52,8 @@ class SegmentationNodelet : public nodelet::Nodelet {
   // model follow in loadCalibration, on loader_'s thread (images are dropped until then).
   bool configure(std::string* error);
   void loadCalibration();
+  // The nodelet could not be configured: it stays loaded and does nothing, saying why.
+  void notStarted(const std::string& error);
   bool applyConfig(const SegmentationConfig& config, std::string* error);
   void connectCb();
   void onImage(const sensor_msgs::ImageConstPtr& msg);
@@ -109,11 +111,14 @@ void SegmentationNodelet::onInit() {
       nh_, pnh_, getName(), "segmentation", [this](diagnostic_updater::DiagnosticStatusWrapper& s) { diagnose(s); },
       &diagnostics_timer_);
   const std::string error = ros_conversions::runConfigure([this](std::string* e) { return configure(e); });
-  if (!error.empty()) {
-    NODELET_ERROR("not started: %s", error.c_str());
-    std::lock_guard<std::mutex> lock(mutex_);
-    config_error_ = error;
-  }
+  if (!error.empty()) notStarted(error);
+}
+
+void SegmentationNodelet::notStarted(const std::string& error) {
+  NODELET_ERROR("not started: %s", error.c_str());
+  std::lock_guard<std::mutex> lock(mutex_);
+  config_error_ = error;
+  loading_ = false;
 }
 
 bool SegmentationNodelet::configure(std::string* error) {
@@ -167,29 +172,13 @@ bool SegmentationNodelet::configure(std::string* error) {
     std::lock_guard<std::mutex> lock(mutex_);
     loading_ = true;
   }
-  loader_.start([this] { loadCalibration(); },
-                [this](const std::string& e) {
-                  NODELET_ERROR("not started: %s", e.c_str());
-                  std::lock_guard<std::mutex> lock(mutex_);
-                  config_error_ = e;
-                  loading_ = false;
-                });
+  loader_.start([this] { loadCalibration(); }, [this](const std::string& e) { notStarted(e); });
   return true;
 }
 
 void SegmentationNodelet::loadCalibration() {
-  core::Calibration calibration;
-  std::string calibration_path, error;
-  if (!ros_conversions::loadCalibrationParam(pnh_, &calibration, &calibration_path, &error)) {
-    NODELET_ERROR("not started: %s", error.c_str());
-    std::lock_guard<std::mutex> lock(mutex_);
-    config_error_ = error;
-    loading_ = false;
-    return;
-  }
-  // A pose off the carpet by more than a metre is a localization failure, not a place to train at.
-  pose_source_.setFieldBounds(0.5 * calibration.field.length_m + calibration.field.margin_m + 1.0,
-                              0.5 * calibration.field.width_m + calibration.field.margin_m + 1.0);
+  std::string calibration_path;
+  const core::Calibration calibration = ros_conversions::loadCalibrationParam(pnh_, &pose_source_, &calibration_path);
   auto camera = std::make_unique<core::OmniCameraModel>(calibration.camera);
   auto segmenter = std::make_unique<core::Segmenter>(calibration.camera);
   bool lazy = false;

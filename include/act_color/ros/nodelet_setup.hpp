@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "act_color/core/calibration.hpp"
+#include "act_color/ros/pose_source.hpp"
 
 // Runs `statement` (a log call) at most once per `period` seconds of wall time at this place:
 // rosconsole's *_THROTTLE runs on ROS time, so with a stopped /clock (a paused bag) it prints once
@@ -64,9 +65,10 @@ class BackgroundTask {
   std::thread thread_;
 };
 
-// The calibration file named by ~calibration (its path in *path). False with the reason.
-bool loadCalibrationParam(const ros::NodeHandle& pnh, core::Calibration* calibration, std::string* path,
-                          std::string* error);
+// The calibration file named by ~calibration (its path in *path); the pose source then refuses
+// poses more than a metre off its carpet (a localization failure, not a place to train at).
+// Throws std::runtime_error with the reason.
+core::Calibration loadCalibrationParam(const ros::NodeHandle& pnh, PoseSource* pose_source, std::string* path);
 
 // ~name in its real type: unchanged and true when it is not set; false with a reason naming the
 // parameter and its value as given when it has another type (`white_filter: 'false'`, `zeta: abc`:
