@@ -90,8 +90,22 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool requestPath(const FilePath::Request& req, FilePath::Response& res, std::string* path) const;
   bool onSaveLut(FilePath::Request& req, FilePath::Response& res);
   bool onLoadLut(FilePath::Request& req, FilePath::Response& res);
+  // A table file: saveLut = prepareSave (the table and the file inside ~lut_dir, under the lock)
+  // + writeTable (the file I/O alone); loadLut = loadPath + readTable (the file I/O alone) +
+  // installTable (under the lock). The services run the I/O parts with a timeout.
+  struct LoadedTable {
+    act_color::ColorLut msg;
+    core::ColorLut lut;
+    std::vector<core::ActTrainer::SavedCluster> clusters;
+  };
   bool saveLut(const std::string& path, std::string* message);
+  bool prepareSave(const std::string& requested, act_color::ColorLutPtr* msg, std::string* path,
+                   std::string* message) const;
+  static bool writeTable(const act_color::ColorLut& msg, const std::string& path, std::string* message);
   bool loadLut(const std::string& path, std::string* message);
+  std::string loadPath(const std::string& requested) const;
+  static bool readTable(const std::string& path, LoadedTable* table, std::string* message);
+  bool installTable(const std::string& path, const LoadedTable& table, std::string* message);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
@@ -774,43 +788,56 @@ void ActTrainerNodelet::publishFieldMarkers(const core::FieldModel& field) {
   field_pub_.publish(markers);
 }
 
+bool ActTrainerNodelet::prepareSave(const std::string& requested, act_color::ColorLutPtr* msg, std::string* path,
+                                    std::string* message) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!ros_conversions::lutPathInside(lut_dir_, requested, path, message)) return false;
+  if (!trainer_ || !has_table_) {
+    *message = trainer_ ? "no table trained yet" : notReady();
+    return false;
+  }
+  std_msgs::Header header;
+  header.stamp = image_time_.latest();
+  *msg = ros_conversions::toMsg(*trainer_, header);
+  return true;
+}
+
+bool ActTrainerNodelet::writeTable(const act_color::ColorLut& msg, const std::string& path, std::string* message) {
+  if (!ros_conversions::saveLutFile(msg, path, message)) return false;
+  *message = "saved the color table (revision " + std::to_string(msg.revision) + ") and its clusters to " + path;
+  return true;
+}
+
 bool ActTrainerNodelet::saveLut(const std::string& requested, std::string* message) {
   act_color::ColorLutPtr msg;
   std::string path;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!ros_conversions::lutPathInside(lut_dir_, requested, &path, message)) return false;
-    if (!trainer_ || !has_table_) {
-      *message = trainer_ ? "no table trained yet" : notReady();
-      return false;
-    }
-    std_msgs::Header header;
-    header.stamp = image_time_.latest();
-    msg = ros_conversions::toMsg(*trainer_, header);
-  }
-  std::string error;
-  if (!ros_conversions::saveLutFile(*msg, path, &error)) {
-    *message = error;
+  return prepareSave(requested, &msg, &path, message) && writeTable(*msg, path, message);
+}
+
+std::string ActTrainerNodelet::loadPath(const std::string& requested) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return !requested.empty() && requested[0] != '/' ? lut_dir_ + "/" + requested : requested;  // relative: in ~lut_dir
+}
+
+bool ActTrainerNodelet::readTable(const std::string& path, LoadedTable* table, std::string* message) {
+  if (!ros_conversions::loadLutFile(path, &table->msg, message)) return false;
+  if (!ros_conversions::fromMsg(table->msg, &table->lut, &table->clusters, message)) {
+    *message = path + ": " + *message;
     return false;
   }
-  *message = "saved the color table (revision " + std::to_string(msg->revision) + ") and its clusters to " + path;
   return true;
 }
 
 bool ActTrainerNodelet::loadLut(const std::string& requested, std::string* message) {
-  act_color::ColorLut msg;
-  core::ColorLut lut;
-  std::vector<core::ActTrainer::SavedCluster> clusters;
-  std::string path = requested;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!path.empty() && path[0] != '/') path = lut_dir_ + "/" + path;  // relative: in ~lut_dir
-  }
-  if (!ros_conversions::loadLutFile(path, &msg, message)) return false;
-  if (!ros_conversions::fromMsg(msg, &lut, &clusters, message)) {
-    *message = path + ": " + *message;
-    return false;
-  }
+  const std::string path = loadPath(requested);
+  LoadedTable table;
+  return readTable(path, &table, message) && installTable(path, table, message);
+}
+
+bool ActTrainerNodelet::installTable(const std::string& path, const LoadedTable& table, std::string* message) {
+  const core::ColorLut& lut = table.lut;
+  const act_color::ColorLut& msg = table.msg;
+  const auto& clusters = table.clusters;
   std::lock_guard<std::mutex> lock(mutex_);
   if (!trainer_) {
     *message = notReady();
@@ -845,7 +872,8 @@ bool ActTrainerNodelet::requestPath(const FilePath::Request& req, FilePath::Resp
 namespace {
 
 // Runs `io` on a thread of its own and waits at most `timeout_s`: a file system that hangs (a dead
-// network mount) leaves the service answering, the I/O thread going on alone.
+// network mount) leaves the service answering, the I/O thread going on alone (so `io` holds what
+// it uses, not the nodelet).
 bool withTimeout(const std::function<bool(std::string*)>& io, double timeout_s, std::string* message) {
   struct Shared {
     std::mutex mutex;
@@ -885,7 +913,13 @@ constexpr double kFileTimeoutS = 5.0;
 bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& res) {
   std::string path;
   if (!requestPath(req, res, &path)) return true;
-  res.success = withTimeout([this, path](std::string* m) { return saveLut(path, m); }, kFileTimeoutS, &res.message);
+  act_color::ColorLutPtr msg;
+  std::string file;
+  // Only the file operation on the I/O thread: it touches nothing of the nodelet, which may be
+  // gone when a hanging file system lets it finish.
+  res.success =
+      prepareSave(path, &msg, &file, &res.message) &&
+      withTimeout([msg, file](std::string* m) { return writeTable(*msg, file, m); }, kFileTimeoutS, &res.message);
   if (!res.success) NODELET_ERROR("~save_lut: %s", res.message.c_str());
   return true;
 }
@@ -893,7 +927,11 @@ bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& re
 bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& res) {
   std::string path;
   if (!requestPath(req, res, &path)) return true;
-  res.success = withTimeout([this, path](std::string* m) { return loadLut(path, m); }, kFileTimeoutS, &res.message);
+  const std::string file = loadPath(path);
+  auto table = std::make_shared<LoadedTable>();
+  res.success = withTimeout([table, file](std::string* m) { return readTable(file, table.get(), m); }, kFileTimeoutS,
+                            &res.message) &&
+                installTable(file, *table, &res.message);
   if (!res.success) NODELET_ERROR("~load_lut: %s", res.message.c_str());
   return true;
 }
