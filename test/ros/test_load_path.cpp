@@ -76,6 +76,27 @@ TEST(LoadPath, CalibrationLoadsOffTheManagersLoadPath) {
   EXPECT_TRUE(unload("/big/segmentation"));
 }
 
+// Nodelets loaded and unloaded again and again, at once or after their calibration loaded, with a
+// service call in between: the manager keeps running and loading.
+TEST(LoadPath, LoadUnloadCycles) {
+  ASSERT_TRUE(ros::service::waitForService("/load_manager/load_nodelet", ros::Duration(30.0)));
+  constexpr int kCycles = 20;
+  int answered = 0;
+  for (int i = 0; i < kCycles; ++i) {
+    ASSERT_TRUE(load("/small/trainer", "act_color/act_trainer")) << "cycle " << i;
+    ASSERT_TRUE(load("/small/segmentation", "act_color/segmentation")) << "cycle " << i;
+    if (i % 2 == 1) {
+      ASSERT_TRUE(ros::service::waitForService("/small/trainer/save_lut", ros::Duration(10.0)));
+      answered += saveAnswer("/small/trainer").empty() ? 0 : 1;
+    }
+    ASSERT_TRUE(unload("/small/segmentation")) << "cycle " << i;
+    ASSERT_TRUE(unload("/small/trainer")) << "cycle " << i;
+  }
+  std::printf("%d load/unload cycles of the trainer and the segmentation; ~save_lut answered %d of %d times\n", kCycles,
+              answered, kCycles / 2);
+  EXPECT_EQ(answered, kCycles / 2);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
