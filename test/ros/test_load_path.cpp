@@ -76,6 +76,24 @@ TEST(LoadPath, CalibrationLoadsOffTheManagersLoadPath) {
   EXPECT_TRUE(unload("/big/segmentation"));
 }
 
+// A calibration that fails to load on the loader's thread: the nodelet stays loaded, says why, and
+// the manager goes on.
+TEST(LoadPath, FailedCalibrationIsReported) {
+  ASSERT_TRUE(ros::service::waitForService("/load_manager/load_nodelet", ros::Duration(30.0)));
+  ASSERT_TRUE(load("/broken/trainer", "act_color/act_trainer"));
+  ASSERT_TRUE(ros::service::waitForService("/broken/trainer/save_lut", ros::Duration(10.0)));
+  const auto start = std::chrono::steady_clock::now();
+  std::string answer = saveAnswer("/broken/trainer");
+  while (answer.find("not configured") == std::string::npos && since(start) < 30.0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    answer = saveAnswer("/broken/trainer");
+  }
+  std::printf("a missing calibration: '%s'\n", answer.c_str());
+  EXPECT_NE(answer.find("the nodelet is not configured: bad calibration"), std::string::npos) << answer;
+  EXPECT_NE(answer.find("/nonexistent/calibration.yaml"), std::string::npos) << answer;
+  EXPECT_TRUE(unload("/broken/trainer"));
+}
+
 // Nodelets loaded and unloaded again and again, at once or after their calibration loaded, with a
 // service call in between: the manager keeps running and loading.
 TEST(LoadPath, LoadUnloadCycles) {
