@@ -129,7 +129,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   // Everything below is guarded by mutex_.
   mutable std::mutex mutex_;
   std::string config_error_;  // non-empty: the nodelet could not be configured and does nothing
-  bool loading_ = false;      // the calibration is being loaded (trainer_ follows)
+  // No trainer yet and no error: the calibration is being loaded (trainer_ follows).
+  bool loading() const { return !trainer_ && config_error_.empty(); }
   std::unique_ptr<core::ActTrainer> trainer_;
   std::unique_ptr<core::Segmenter> segmenter_;
   core::ActParams params_;
@@ -211,7 +212,6 @@ void ActTrainerNodelet::notStarted(const std::string& error) {
   NODELET_ERROR("not started: %s", error.c_str());
   std::lock_guard<std::mutex> lock(mutex_);
   config_error_ = error;
-  loading_ = false;
 }
 
 bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) {
@@ -386,10 +386,6 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // A few frames of slack (as the segmentation): a slow cycle, or a busy machine replaying a bag,
   // does not drop frames at once.
   image_sub_ = it_->subscribe("image", 5, &ActTrainerNodelet::onImage, this, hints);
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    loading_ = true;
-  }
   loader_.start([this, params, load_path] { loadCalibration(params, load_path); },
                 [this](const std::string& e) { notStarted(e); });
   return true;
@@ -405,7 +401,6 @@ void ActTrainerNodelet::loadCalibration(const core::ActParams& params, const std
     std::lock_guard<std::mutex> lock(mutex_);
     trainer_ = std::move(trainer);
     segmenter_ = std::move(segmenter);
-    loading_ = false;
     params_changed_ = true;  // ~dynamic_reconfigure may have changed them while loading
   }
   if (!load_path.empty()) {
@@ -432,7 +427,7 @@ void ActTrainerNodelet::loadCalibration(const core::ActParams& params, const std
 }
 
 std::string ActTrainerNodelet::notReady() const {
-  if (loading_) return "the calibration is still loading";
+  if (loading()) return "the calibration is still loading";
   return "the nodelet is not configured: " + config_error_;
 }
 
@@ -517,7 +512,7 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
 void ActTrainerNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
   try {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!trainer_ && !loading_) return;
+    if (!trainer_ && !loading()) return;
     const ros::Time before = image_time_.latest();
     if (image_time_.jumpedBack(msg->header.stamp)) onTimeJump(before, msg->header.stamp);
     ++images_;
@@ -939,7 +934,7 @@ bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& re
 void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
-  if (loading_) {
+  if (loading()) {
     status.summary(DiagnosticStatus::WARN, "loading the calibration");
     status.add("images waiting", pending_.size());
     return;

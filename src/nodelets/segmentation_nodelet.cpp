@@ -80,6 +80,9 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::string config_error_;
   std::unique_ptr<core::OmniCameraModel> camera_;
   std::unique_ptr<core::Segmenter> segmenter_;
+  // No segmenter yet and no error: the calibration is being loaded (segmenter_, camera_ and field_
+  // follow).
+  bool loading() const { return !segmenter_ && config_error_.empty(); }
   core::FieldCalibration field_;
   core::FeatureParams feature_params_;
   bool lazy_ = false;
@@ -100,7 +103,6 @@ class SegmentationNodelet : public nodelet::Nodelet {
   static constexpr double kWindowS = 5.0;
   ros_conversions::RecentWindow<Record> window_{kWindowS};
   ros::WallTime last_image_, last_table_;
-  bool loading_ = false;  // the calibration is being loaded (segmenter_, camera_ and field_ follow)
   ros_conversions::BackgroundTask loader_;
 };
 
@@ -118,7 +120,6 @@ void SegmentationNodelet::notStarted(const std::string& error) {
   NODELET_ERROR("not started: %s", error.c_str());
   std::lock_guard<std::mutex> lock(mutex_);
   config_error_ = error;
-  loading_ = false;
 }
 
 bool SegmentationNodelet::configure(std::string* error) {
@@ -168,10 +169,6 @@ bool SegmentationNodelet::configure(std::string* error) {
     }
   });
   connectCb();
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    loading_ = true;
-  }
   loader_.start([this] { loadCalibration(); }, [this](const std::string& e) { notStarted(e); });
   return true;
 }
@@ -189,7 +186,6 @@ void SegmentationNodelet::loadCalibration() {
     camera_ = std::move(camera);
     segmenter_ = std::move(segmenter);
     field_ = calibration.field;
-    loading_ = false;
     lazy = lazy_;
   }
   NODELET_INFO("segmentation ready: calibration %s, %s", calibration_path.c_str(),
@@ -254,7 +250,7 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (!segmenter_) {
-        if (loading_) ACT_WALL_THROTTLE(2.0, NODELET_INFO("image dropped: the calibration is still loading"));
+        if (loading()) ACT_WALL_THROTTLE(2.0, NODELET_INFO("image dropped: the calibration is still loading"));
         return;
       }
       const ros::Time before = image_time_.latest();
@@ -449,7 +445,7 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
 void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
-  if (loading_) {
+  if (loading()) {
     status.summary(DiagnosticStatus::WARN, "loading the calibration");
     return;
   }
