@@ -122,23 +122,6 @@ bool startsLikeABag(const std::string& path) {
   return file && std::string(head, sizeof(head)) == "#ROSBAG V";
 }
 
-// Why an image of `bytes_per_pixel` bytes per pixel cannot be read over its data, or "".
-std::string layoutProblem(const sensor_msgs::Image& image, size_t bytes_per_pixel) {
-  std::ostringstream s;
-  const uint64_t min_step = static_cast<uint64_t>(bytes_per_pixel) * image.width;
-  const uint64_t min_size = static_cast<uint64_t>(image.step) * image.height;
-  if (image.width == 0 || image.height == 0) {
-    s << "empty image (" << image.width << "x" << image.height << ")";
-  } else if (image.step < min_step) {
-    s << "step " << image.step << " is less than width " << image.width << " * " << bytes_per_pixel
-      << " bytes per pixel (" << image.encoding << ") = " << min_step;
-  } else if (image.data.size() < min_size) {
-    s << "data has " << image.data.size() << " bytes, less than step " << image.step << " * height " << image.height
-      << " = " << min_size;
-  }
-  return s.str();
-}
-
 // The output bag: written as PATH.active and renamed to PATH by commit(), removed when the replay
 // fails, so that no half-written bag is left looking complete.
 class OutputBag {
@@ -183,25 +166,13 @@ class OutputBag {
 
 }  // namespace
 
-std::string imageMessageProblem(const sensor_msgs::Image& image) {
-  core::PixelFormat format;
-  if (!core::pixelFormatFromEncoding(image.encoding, &format)) {
-    return "unsupported encoding '" + image.encoding + "' (expected rgb8, bgr8 or yuv422)";
-  }
-  const std::string problem = layoutProblem(image, core::bytesPerPixel(format));
-  if (problem.empty() && format == core::PixelFormat::kUyvy && image.width % 2 != 0) {
-    return "yuv422 image with an odd width " + std::to_string(image.width);
-  }
-  return problem;
-}
-
 std::string truthMessageProblem(const sensor_msgs::Image& truth, uint32_t width, uint32_t height) {
   if (truth.encoding != "mono8") return "truth encoding '" + truth.encoding + "', expected mono8";
   if (truth.width != width || truth.height != height) {
     return "truth is " + std::to_string(truth.width) + "x" + std::to_string(truth.height) + ", its image " +
            std::to_string(width) + "x" + std::to_string(height);
   }
-  const std::string problem = layoutProblem(truth, 1);
+  const std::string problem = ros_conversions::imageLayoutProblem(truth, 1);
   return problem.empty() ? problem : "truth " + problem;
 }
 
@@ -280,8 +251,8 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
 
     // Nothing of the message is read before it has been checked against itself.
     core::ImageView view;
-    std::string error = imageMessageProblem(*image);
-    bool usable = error.empty() && ros_conversions::imageView(*image, &view, &error);
+    std::string error;
+    bool usable = ros_conversions::imageView(*image, &view, &error);
     if (usable) {
       try {
         trainer.checkImage(view);

@@ -14,26 +14,39 @@ core::ColorSpace colorSpace(const act_color::ColorLut& msg) {
 
 }  // namespace
 
-bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::string* error) {
+std::string imageLayoutProblem(const sensor_msgs::Image& image, size_t bytes_per_pixel) {
+  std::ostringstream s;
+  const uint64_t min_step = static_cast<uint64_t>(bytes_per_pixel) * image.width;
+  const uint64_t min_size = static_cast<uint64_t>(image.step) * image.height;
+  if (image.width == 0 || image.height == 0) {
+    s << "empty image (" << image.width << "x" << image.height << ")";
+  } else if (image.step < min_step) {
+    s << "step " << image.step << " is less than width " << image.width << " * " << bytes_per_pixel
+      << " bytes per pixel (" << image.encoding << ") = " << min_step;
+  } else if (image.data.size() < min_size) {
+    s << "data has " << image.data.size() << " bytes, less than step " << image.step << " * height " << image.height
+      << " = " << min_size;
+  }
+  return s.str();
+}
+
+std::string imageMessageProblem(const sensor_msgs::Image& image) {
   core::PixelFormat format;
   if (!core::pixelFormatFromEncoding(image.encoding, &format)) {
-    *error = "unsupported encoding '" + image.encoding + "' (expected rgb8, bgr8 or yuv422)";
-    return false;
+    return "unsupported encoding '" + image.encoding + "' (expected rgb8, bgr8 or yuv422)";
   }
-  const size_t bytes_per_pixel = core::bytesPerPixel(format);
-  if (image.width == 0 || image.height == 0) {
-    *error = "empty image";
-    return false;
+  const std::string problem = imageLayoutProblem(image, core::bytesPerPixel(format));
+  if (problem.empty() && format == core::PixelFormat::kUyvy && image.width % 2 != 0) {
+    return "yuv422 image with an odd width " + std::to_string(image.width);
   }
-  if (image.step < bytes_per_pixel * image.width ||
-      image.data.size() < static_cast<size_t>(image.step) * image.height) {
-    *error = "image data is shorter than step * height";
-    return false;
-  }
-  if (format == core::PixelFormat::kUyvy && image.width % 2 != 0) {
-    *error = "yuv422 image with an odd width";
-    return false;
-  }
+  return problem;
+}
+
+bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::string* error) {
+  *error = imageMessageProblem(image);
+  if (!error->empty()) return false;
+  core::PixelFormat format;
+  core::pixelFormatFromEncoding(image.encoding, &format);
   *view = core::ImageView(image.data.data(), static_cast<int>(image.width), static_cast<int>(image.height), image.step,
                           format);
   return true;

@@ -9,6 +9,7 @@
 
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/run_evaluation.hpp"
+#include "act_color/ros/conversions.hpp"
 
 namespace act_color {
 namespace ros_layer {
@@ -56,10 +57,8 @@ class ReplayError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Why a camera image message cannot be read safely (encoding rgb8, bgr8 or yuv422; width and
-// height not 0; step >= width * bytes per pixel; data.size() >= step * height; an even width for
-// yuv422), or "" when it can. Checks the message against itself only, not against a calibration.
-std::string imageMessageProblem(const sensor_msgs::Image& image);
+// Why a camera image message cannot be read safely, or "" (the nodelets' check).
+using ros_conversions::imageMessageProblem;
 // The same for a truth label image: mono8, `width` x `height` (those of its camera image), step
 // >= width, data.size() >= step * height.
 std::string truthMessageProblem(const sensor_msgs::Image& truth, uint32_t width, uint32_t height);

@@ -17,7 +17,13 @@
 namespace act_color {
 namespace ros_conversions {
 
-// A view of a sensor_msgs/Image (rgb8, bgr8, yuv422); false with a reason for anything else.
+// Why a camera image message cannot be read safely (encoding rgb8, bgr8 or yuv422; width and
+// height not 0; step >= width * bytes per pixel; data.size() >= step * height; an even width for
+// yuv422), or "" when it can. Checks the message against itself only, not against a calibration.
+std::string imageMessageProblem(const sensor_msgs::Image& image);
+// The layout part of it for `bytes_per_pixel` bytes per pixel (sizes, step, data), or "".
+std::string imageLayoutProblem(const sensor_msgs::Image& image, size_t bytes_per_pixel);
+// A view of a sensor_msgs/Image (rgb8, bgr8, yuv422); false with imageMessageProblem's reason.
 bool imageView(const sensor_msgs::Image& image, core::ImageView* view, std::string* error);
 
 // The table and clusters of a trainer as a message (the table is copied once).
