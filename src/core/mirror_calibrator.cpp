@@ -88,13 +88,24 @@ ColorMasks colorMasks(const cv::Mat& bgr) {
     l0 = carpet_l[carpet_l.size() / 2];
   }
   constexpr double kChromaTolerance = 10.0;
+  const double ca0 = a0 - 128.0, cb0 = b0 - 128.0, chroma0 = std::hypot(ca0, cb0);
   m.green = cv::Mat::zeros(bgr.size(), CV_8UC1);
   for (int v = 0; v < lab.rows; ++v) {
     const cv::Vec3b* row = lab.ptr<cv::Vec3b>(v);
     uint8_t* out = m.green.ptr<uint8_t>(v);
     for (int u = 0; u < lab.cols; ++u) {
       const double da = row[u][1] - a0, db = row[u][2] - b0, l = row[u][0];
-      out[u] = (da * da + db * db <= kChromaTolerance * kChromaTolerance && l >= 0.45 * l0 && l <= 1.6 * l0) ? 255 : 0;
+      if (l < 0.45 * l0 || l > 1.6 * l0) continue;
+      bool carpet = da * da + db * db <= kChromaTolerance * kChromaTolerance;
+      // A saturated carpet keeps its hue where it is lit brighter (a spot, one channel clipped) and
+      // its chroma moves along it: on one scene the lit carpet around the chassis was 9-10 units
+      // from the mode, and its holes looked like the chassis.
+      if (!carpet && chroma0 >= 25.0) {
+        const double ca = row[u][1] - 128.0, cb = row[u][2] - 128.0, chroma = std::hypot(ca, cb);
+        const double cos_angle = (ca * ca0 + cb * cb0) / std::max(1e-9, chroma * chroma0);
+        carpet = chroma >= 0.6 * chroma0 && chroma <= 1.5 * chroma0 && cos_angle >= std::cos(12.0 * M_PI / 180.0);
+      }
+      out[u] = carpet ? 255 : 0;
     }
   }
   return m;
@@ -697,6 +708,23 @@ ImageGeometry MirrorCalibrator::estimateImageGeometry(const cv::Mat& bgr) const 
   // The floor near the robot is carpet or line: the own chassis is the large non-floor blob it
   // encloses. Struts (thin) are opened away so that the blob does not leak along them.
   cv::Mat floor = masks.green | masks.whiteish;
+  {
+    // Lines are brighter than the carpet, a chassis far darker: a dark grey one in sensor noise is
+    // partly "whiteish" too (V around 70), and its blob fell apart (on one scene the chassis taken
+    // was a dark piece 43 px from the mirror centre).
+    std::vector<float> carpet_luma;
+    for (int v = 0; v < bgr.rows; v += 3) {
+      for (int u = 0; u < bgr.cols; u += 3) {
+        if (masks.green.at<uint8_t>(v, u)) carpet_luma.push_back(masks.luma.at<float>(v, u));
+      }
+    }
+    if (!carpet_luma.empty()) {
+      std::nth_element(carpet_luma.begin(), carpet_luma.begin() + static_cast<long>(carpet_luma.size() / 2),
+                       carpet_luma.end());
+      const cv::Mat lit = masks.luma >= 0.5 * carpet_luma[carpet_luma.size() / 2];
+      floor = masks.green | (masks.whiteish & lit);
+    }
+  }
   cv::morphologyEx(floor, floor, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
   cv::Mat not_floor = ~floor;
   const int k = std::max(9, (std::min(bgr.cols, bgr.rows) / 40) | 1);
@@ -753,12 +781,14 @@ std::vector<cv::Point2f> MirrorCalibrator::findLinePixels(const cv::Mat& bgr, co
   const double noise_level = cv::mean(noise)[0];
   const double threshold = std::max(14.0, 4.0 * noise_level);
   cv::Mat bright = tophat > threshold;
-  // Lines are painted on the carpet: green within a few pixels on both sides along one of four
-  // directions. The carpet's own edge (the grey floor or a wall beyond the margin) has it on one
-  // side only; taken for a line it let fits shrink the profile at the rim until that edge fell on
-  // the outer line (7 of the first 16 tuning scenes fitted 4-20% short there).
+  // Lines are painted on the carpet: green next to them, and within a few pixels on both sides
+  // along one of four directions. The carpet's own edge (the grey floor or a wall beyond the
+  // margin) has it on one side only; taken for a line it let fits shrink the profile at the rim
+  // until that edge fell on the outer line (7 of the first 16 tuning scenes fitted 4-20% short).
   const int kg = std::max(5, (k / 2) | 1);
-  cv::Mat line = bright & masks.whiteish & ~masks.green;
+  cv::Mat near_green;
+  cv::dilate(masks.green, near_green, cv::getStructuringElement(cv::MORPH_ELLIPSE, {kg, kg}));
+  cv::Mat line = bright & masks.whiteish & near_green & ~masks.green;
   const auto greenWithin = [&](int u, int v, int du, int dv) {
     for (int t = 1; t <= kg; ++t) {
       const int x = u + t * du, y = v + t * dv;
