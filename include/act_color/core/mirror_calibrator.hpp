@@ -38,7 +38,7 @@ struct MirrorCalibratorOptions {
   std::optional<double> bearing_offset_rad;  // fixed: the heading is refined instead
   // Rejection: an image whose fit is worse than this is refused. Residual and inliers count the
   // line pixels that land on the carpet (field and margin). Line pixels have carpet on both sides:
-  // a right fit takes 0.82-0.99 of them for inliers (NuBot's images, simulated cameras), the
+  // a right fit takes 0.8-1.0 of them for inliers (NuBot's images, simulated cameras), most
   // wrong fits seen 0.43-0.62.
   double max_median_residual_m = 0.05;
   double min_inlier_fraction = 0.7;
