@@ -16,6 +16,7 @@
 
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/mirror_calibrator.hpp"
+#include "act_color/sim/calibrator_check.hpp"
 
 namespace {
 
@@ -26,6 +27,7 @@ const char* const kUsage =
     "       act_calibrate --nubot mirror_calib.xml [--roi ROI.xml] (--image IMG | --size WxH)\n"
     "                     (--field CAL.yaml | --preset NAME) [options]             import a NuBot fit\n"
     "       act_calibrate --check CAL.yaml --image IMG [options]                   measure a calibration\n"
+    "       act_calibrate --family A-B      fit the simulator's random cameras of seeds A-B (truth known)\n"
     "  --field CAL.yaml      copy the field section of this calibration\n"
     "  --preset NAME         msl2007 (18 x 12 m) or lab6x4 (6 x 4 m lab field)\n"
     "  --pose x,y,theta      rough pose (m, m, rad) of the robot; default 0,0,0: on the centre\n"
@@ -41,7 +43,7 @@ const char* const kUsage =
     "                        (default: the monotone one when its residual is 5% smaller)\n"
     "  --max-residual M      reject above this median line-pixel residual (default 0.05 m)\n"
     "  --min-inliers F       reject below this fraction of line pixels on the carpet within 0.08 m\n"
-    "                        (default 0.5)\n"
+    "                        (default 0.7)\n"
     "  --max-carpet-on-lines F  reject when more of the carpet lands on the model's lines (default 0.03)\n"
     "  --output CAL.yaml     write the calibration (validated first)\n"
     "  --overlay OUT.png     the image with the model's lines (magenta) and the line pixels found\n"
@@ -80,7 +82,29 @@ void printResidual(const std::string& what, const core::LineResidual& r) {
 
 }  // namespace
 
+// --family A-B: the calibrator on the randomized family's cameras, against their true calibration.
+int checkFamily(const std::string& range) {
+  const size_t dash = range.find('-');
+  if (dash == std::string::npos || dash == 0 || dash + 1 == range.size() ||
+      range.find_first_not_of("0123456789-") != std::string::npos) {
+    return usage("--family wants A-B (seeds), not '" + range + "'");
+  }
+  const unsigned long first = std::stoul(range.substr(0, dash)), last = std::stoul(range.substr(dash + 1));
+  if (last < first || last - first > 1000) return usage("--family: A-B with A <= B and at most 1000 seeds");
+  std::vector<act_color::sim::CalibratorCheck> checks;
+  for (unsigned long seed = first; seed <= last; ++seed) {
+    checks.push_back(act_color::sim::checkCalibrator(static_cast<uint32_t>(seed)));
+    std::cerr << "act_calibrate: seed " << seed << (checks.back().passed() ? " within the targets\n" : " off\n");
+  }
+  std::cout << act_color::sim::formatCalibratorChecks(checks);
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "--family") {
+    if (argc != 3) return usage("--family takes one range A-B and no other option");
+    return checkFamily(argv[2]);
+  }
   std::string image_path, field_path, preset, output, overlay, whites, nubot, roi, check;
   int size_w = 0, size_h = 0;
   core::MirrorCalibratorOptions options;

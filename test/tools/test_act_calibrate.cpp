@@ -1,5 +1,5 @@
 // act_calibrate as a user runs it: a simulated field image fitted into a file that loads, images
-// without a field refused (non-zero exit, nothing written), the NuBot import.
+// without a field refused (non-zero exit, nothing written), the NuBot import, the --family check.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -105,4 +105,16 @@ TEST(ActCalibrate, ImportsANubotMirrorFit) {
   EXPECT_EQ(b.exit_code, 1);
   EXPECT_NE(b.output.find("center_row"), std::string::npos) << b.output;
   EXPECT_FALSE(exists(bad_out));
+}
+
+// --family: the calibrator on the simulator's cameras against their truth; one table row per seed
+// and a count (seed 1003 is one of the cameras it fits within the targets).
+TEST(ActCalibrate, ChecksItselfOnTheSimulatorsCameras) {
+  const ToolRun r = run("--family 1003-1003");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("| 1003 | within the targets |"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("1 of 1 cameras within the targets"), std::string::npos) << r.output;
+  EXPECT_EQ(run("--family 5-3").exit_code, 2);
+  EXPECT_EQ(run("--family x").exit_code, 2);
+  EXPECT_EQ(run("--family 1-2 --preset lab6x4").exit_code, 2);
 }
