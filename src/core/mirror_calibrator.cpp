@@ -712,18 +712,13 @@ ImageGeometry MirrorCalibrator::estimateImageGeometry(const cv::Mat& bgr) const 
     // Lines are brighter than the carpet, a chassis far darker: a dark grey one in sensor noise is
     // partly "whiteish" too (V around 70), and its blob fell apart (on one scene the chassis taken
     // was a dark piece 43 px from the mirror centre).
-    std::vector<float> carpet_luma;
+    std::vector<double> carpet_luma;
     for (int v = 0; v < bgr.rows; v += 3) {
       for (int u = 0; u < bgr.cols; u += 3) {
         if (masks.green.at<uint8_t>(v, u)) carpet_luma.push_back(masks.luma.at<float>(v, u));
       }
     }
-    if (!carpet_luma.empty()) {
-      std::nth_element(carpet_luma.begin(), carpet_luma.begin() + static_cast<long>(carpet_luma.size() / 2),
-                       carpet_luma.end());
-      const cv::Mat lit = masks.luma >= 0.5 * carpet_luma[carpet_luma.size() / 2];
-      floor = masks.green | (masks.whiteish & lit);
-    }
+    if (!carpet_luma.empty()) floor = masks.green | (masks.whiteish & (masks.luma >= 0.5 * median(carpet_luma)));
   }
   cv::morphologyEx(floor, floor, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_ELLIPSE, {5, 5}));
   cv::Mat not_floor = ~floor;
