@@ -31,9 +31,12 @@ constexpr size_t kChassisAnchorSamples = 192;
 // kLightChangeMinShift channel units, whichever is larger. The median itself jitters by about one
 // unit from frame to frame, green's sigma (eq. 5) is some 13: at 1.0 a warm white balance of
 // 1500 K (a shift of 0.96 sigma) went unnoticed with 7 of 10 random seeds, and white took 4-9
-// cycles instead of 1.
-constexpr double kLightChangeSigmas = 0.75;
-constexpr double kLightChangeMinShift = 8.0;
+// cycles instead of 1. Each kept light (restoreLightState) serves the levels within this distance
+// of its own: at 0.75 sigma and 8 units an exposure swinging 1 +- 0.3 was served by three tables,
+// each used some 15% above and below the level it was made for, where hall colors fall into the
+// goals' cells (precision 0.1-0.15 below a table of the frame's own level).
+constexpr double kLightChangeSigmas = 0.4;
+constexpr double kLightChangeMinShift = 5.0;
 
 // The evidence removal ratio for the ball's colors (at most ActParams::evidence_removal_ratio): a
 // color of the ball seen off the field as often as on it gives more false sightings than true.
@@ -416,7 +419,7 @@ bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t curre
   return (other.mean() - color).norm() / other.sigma() <= (own.mean() - color).norm() / own.sigma();
 }
 
-void ActTrainer::applyLightChange(const LightModel::Map& map, bool keep_rest) {
+void ActTrainer::applyLightChange(const LightModel::Map& map) {
   const ClusterParams cluster_params = clusterParams();
   for (auto& cluster : clusters_) {
     const double scale = std::clamp(map.maxSlope(cluster.mean(), cluster.sigma()), 0.1, 10.0);
@@ -426,16 +429,13 @@ void ActTrainer::applyLightChange(const LightModel::Map& map, bool keep_rest) {
   // lie in the image of the cell's box of colors (a box again: the map is per channel) take its
   // class, or, when the map shrinks the box between two centres, the cell of its mapped centre.
   // Where the map stretches colors the moved cells thus leave no holes between them, and a map
-  // near the identity does not dilate the classes. Moved
-  // cells win over what was there (stale mappings of the old light), the rest stays.
+  // near the identity does not dilate the classes. The table holds the moved cells only: the old
+  // light's cells are kept with its state (keepLightState); left in the table, they showed hall
+  // colors of the new light as goals and were carried on by every later move.
   const int bits = lut_.bitsPerChannel();
   const int cells = 1 << bits;
   const double width = 1 << (8 - bits);
-  if (keep_rest) {
-    warped_.assign(lut_.table().begin(), lut_.table().end());
-  } else {
-    warped_.assign(lut_.size(), kUnknown);
-  }
+  warped_.assign(lut_.size(), kUnknown);
   warped_neighbour_only_.assign(neighbour_only_.begin(), neighbour_only_.end());
   warped_evidence_.assign(evidence_.begin(), evidence_.end());
   const uint32_t mask = (1u << bits) - 1;
@@ -623,22 +623,26 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
   chassis_samples_.clear();
+  carpet_samples_.clear();
   everyNth(params_.cluster_stride, [&](const StridedPixels& p) {
     const uint8_t expected_k = expected(p);
     if (expected_k == kUnknown || expected_k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
+    if (expected_k == kGreen) carpet_samples_.emplace_back(c[0], c[1], c[2]);
     samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
   });
   // The anchors of the light model (before any class filters its colors): carpet and lines from
-  // the cluster samples, the chassis densely.
+  // the cluster samples, the chassis densely. The carpet as the pose expects it, before
+  // robots_train_black: the paper's darkening takes the carpet below 60% of green's intensity,
+  // where all of it would train black, and the change went unseen for 4 frames (tuning seed 20).
   if (params_.light_compensation) {
     for (const uint32_t i : chassis_pixels_) {
       uint8_t c[3];
       image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
       chassis_samples_.emplace_back(c[0], c[1], c[2]);
     }
-    light_.observe(samples_[kGreen], samples_[kWhite], chassis_samples_);
+    light_.observe(carpet_samples_, samples_[kWhite], chassis_samples_);
   }
   const ClusterParams cluster_params = clusterParams();
   const ClassCluster& green = clusters_[kGreen];
@@ -670,9 +674,6 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     light_changed = light_.estimate(lut_.colorSpace(), &light_map);
   }
   if (light_changed) {
-    // A light within the memory of another: the old light's cells are kept with its state, so the
-    // moved table holds only the moved cells (moving the union to and fro spreads the classes).
-    const bool keep_rest = light_states_.empty();
     keepLightState();
     const Eigen::Vector3d from = light_.referenceGreenMedian();
     const Eigen::Vector3d pivot = LightModel::pivot(lut_.colorSpace());
@@ -680,7 +681,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       const double d = from[c] - pivot[c];
       stats.light_gain[c] = static_cast<float>(std::abs(d) > 1e-6 ? (light_map.at(c, from[c]) - pivot[c]) / d : 1.0);
     }
-    applyLightChange(light_map, keep_rest);
+    applyLightChange(light_map);
     light_.rebase(light_map);
     stats.light_change = true;
   } else if (params_.light_compensation) {

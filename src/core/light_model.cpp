@@ -85,6 +85,7 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
   for (int c = 0; c < 3; ++c) {
     // Anchor points (before, after), and the anchor classes' medians for the slope check.
     std::vector<std::pair<double, double>> points, medians;
+    bool top = false;
     int classes = 0;
     for (int a = 0; a < kAnchorClasses; ++a) {
       const auto& cur = current_.quantiles[a];
@@ -95,12 +96,17 @@ bool LightModel::estimate(ColorSpace space, Map* map) const {
       const size_t before = points.size();
       for (size_t l = 0; l < cur.size(); ++l) {
         if (!clipped(cur[l][c]) && !clipped(ref[l][c])) points.emplace_back(ref[l][c], cur[l][c]);
+        // Saturated before and after: the top of the channel stays where it is (the clipped core
+        // of a line under gamma 1.6 or a brightening; extrapolated instead, the map took 255 some
+        // 10 units down and the saturated white cell left the lines).
+        top = top || (cur[l][c] >= 255.0 - kClipMargin && ref[l][c] >= 255.0 - kClipMargin);
       }
       if (points.size() == before) continue;
       ++classes;
       const size_t median = cur.size() / 2;
       if (!clipped(cur[median][c]) && !clipped(ref[median][c])) medians.emplace_back(ref[median][c], cur[median][c]);
     }
+    if (top) points.emplace_back(255.0, 255.0);
     // One anchor class alone spans too little of the channel: a gain about the channel's zero.
     if (classes < 2 && !points.empty() && std::abs(reference_green[c] - pivot[c]) >= kMinAnchorDistance) {
       points.emplace_back(pivot[c], pivot[c]);

@@ -40,7 +40,7 @@ struct ActParams {
   // removed when seen off the field, whatever its distance from the cluster (off-field colors
   // near a class, like a whitish hall floor, do not stay in the class by vicinity alone).
   int add_neighbourhood_cells = 1;
-  // When the carpet's median color jumps beyond 0.75 sigma of green (a global change of light or
+  // When the carpet's median color jumps beyond 0.4 sigma of green (a global change of light or
   // of the camera's settings), the per-channel monotone map of colors estimated by LightModel
   // (quantiles of the carpet, line and chassis pixels before and after) moves every cluster and
   // the table, so that all classes follow at once instead of re-learning from sparse samples.
@@ -180,7 +180,7 @@ class ActTrainer {
   // ActParams::evidence_removal_ratio for class k (lower for the ball).
   double evidenceRatio(uint8_t k) const;
   // Light compensation: the map moves every cluster and every table cell.
-  void applyLightChange(const LightModel::Map& map, bool keep_rest);
+  void applyLightChange(const LightModel::Map& map);
   // Light that comes and goes (flicker, an exposure controller hunting, one dark frame in ten):
   // the state of each light recently left is kept, and a change back to one of them restores its
   // table, clusters and evidence instead of moving the table once more. Moving it to and fro would
@@ -225,6 +225,7 @@ class ActTrainer {
   std::array<std::vector<MeanBoundary>, kNumClasses> mean_boundaries_;
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
+  std::vector<Eigen::Vector3f> carpet_samples_;   // expected green, before robots_train_black: an anchor
   std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> anchor_samples_;  // scratch of a denser look
   std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, about 192
@@ -246,7 +247,8 @@ class ActTrainer {
     LightModel light;
     uint64_t left_at = 0;  // revision when this light was left
   };
-  static constexpr size_t kMaxLightStates = 6;
+  // An exposure swinging 1 +- 0.3 passes some 6-8 lights at the trigger of a change (act_trainer.cpp).
+  static constexpr size_t kMaxLightStates = 8;
   std::vector<LightState> light_states_;  // the most recently left last
   // One bit per table cell: mapped to a class (32 KB for 6 bits per channel).
   std::vector<uint64_t> mapped_;
