@@ -1,0 +1,107 @@
+#include "act_color/sim/flicker_evaluation.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "act_color/core/segmenter.hpp"
+#include "act_color/sim/tone_curve.hpp"
+
+namespace act_color {
+namespace sim {
+
+FlickerFrames steadyLightFrames(const FamilyScene& scene, size_t count) {
+  const Renderer renderer(scene.calibration, scene.renderer);
+  const Lighting light = scene.scenario.frames[0].scene.lighting;
+  FlickerFrames out;
+  for (size_t i = 0; i < count; ++i) {
+    Scene s = scene.scenario.frames[std::min(i, scene.scenario.frames.size() - 1)].scene;
+    s.lighting = light;
+    s.noise_seed = static_cast<uint32_t>(i + 1);
+    out.frames.push_back(renderer.render(s));
+    out.poses.push_back(s.robot_pose);
+  }
+  return out;
+}
+
+FlickerRun playWithGains(const FamilyScene& scene, const FlickerFrames& frames, const std::vector<double>& gains,
+                         const core::ActParams& params) {
+  core::ActTrainer trainer(scene.calibration, params);
+  const core::Segmenter segmenter(scene.calibration.camera);
+  FlickerRun run;
+  cv::Mat labels;
+  for (size_t i = 0; i < frames.frames.size(); ++i) {
+    cv::Mat rgb = frames.frames[i].rgb.clone();
+    if (gains[i] != 1.0) ToneCurve::gain(Eigen::Vector3d::Constant(gains[i])).apply(rgb);
+    const core::ImageView view = core::ImageView::fromMat(rgb, core::PixelFormat::kRgb8);
+    if (i == 0) {
+      trainer.bootstrap(view, frames.poses[i], core::kDefaultBootstrapCycles);
+    } else {
+      const core::CycleStats stats = trainer.cycle(view, frames.poses[i]);
+      run.light_changes += stats.light_change;
+      run.restores += stats.light_restored;
+    }
+    const auto counts = trainer.lut().cellCounts();
+    double filled = 0;
+    for (int k = 1; k < core::kNumClasses; ++k) filled += counts[k];
+    run.fill.push_back(filled / static_cast<double>(trainer.lut().size()));
+    segmenter.classify(trainer.lut(), view, labels);
+    run.per_frame.emplace_back();
+    run.per_frame.back().add(labels, frames.frames[i].labels);
+  }
+  return run;
+}
+
+std::vector<double> everyNthFrame(size_t count, int period, double gain) {
+  std::vector<double> gains(count, 1.0);
+  for (size_t i = 0; period > 0 && i < count; ++i) {
+    if (static_cast<int>(i % static_cast<size_t>(period)) == period - 1) gains[i] = gain;
+  }
+  return gains;
+}
+
+std::vector<double> exposureSwing(size_t count, size_t first, double amplitude, double hz) {
+  std::vector<double> gains(count, 1.0);
+  for (size_t i = first; i < count; ++i) {
+    gains[i] = 1.0 + amplitude * std::sin(2.0 * M_PI * hz * static_cast<double>(i - first) / 30.0 + 0.5);
+  }
+  return gains;
+}
+
+const std::vector<double>& steadyReferenceGains() {
+  static const std::vector<double> gains = {0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3};
+  return gains;
+}
+
+FlickerComparison compareWithSteadyLight(const FlickerRun& run, const std::vector<double>& gains,
+                                         const std::vector<FlickerRun>& references, size_t first) {
+  const std::vector<double>& levels = steadyReferenceGains();
+  FlickerComparison out;
+  int compared = 0;
+  for (size_t i = first; i < run.fill.size(); ++i) {
+    if (gains[i] < 0.65 || gains[i] > 1.35) continue;
+    size_t best = 0;
+    for (size_t l = 1; l < levels.size(); ++l) {
+      if (std::abs(levels[l] - gains[i]) < std::abs(levels[best] - gains[i])) best = l;
+    }
+    const FlickerRun& reference = references[best];
+    const double ratio = run.fill[i] / std::max(reference.fill[i], 1e-9);
+    out.fill_max_ratio = std::max(out.fill_max_ratio, ratio);
+    out.fill_mean_ratio += ratio;
+    out.run.merge(run.per_frame[i]);
+    out.reference.merge(reference.per_frame[i]);
+    ++compared;
+  }
+  if (compared > 0) out.fill_mean_ratio /= compared;
+  out.worst_precision_drop = -1.0;
+  for (const int k : core::trainableClasses()) {
+    const double drop = out.reference.precision(k) - out.run.precision(k);
+    if (std::isfinite(drop) && drop > out.worst_precision_drop) {
+      out.worst_precision_drop = drop;
+      out.worst_class = k;
+    }
+  }
+  return out;
+}
+
+}  // namespace sim
+}  // namespace act_color
