@@ -629,7 +629,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     if (expected_k == kUnknown || expected_k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
-    if (expected_k == kGreen) carpet_samples_.emplace_back(c[0], c[1], c[2]);
+    if (expected_k == kGreen && params_.light_compensation) carpet_samples_.emplace_back(c[0], c[1], c[2]);
     samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
   });
   // The anchors of the light model (before any class filters its colors): carpet and lines from
