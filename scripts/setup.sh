@@ -20,7 +20,7 @@ ACT_DEB_PACKAGES=(
   rospack-tools libopencv-dev libeigen3-dev libgtest-dev rosbash python3-rosmsg
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libdiagnostic-updater-dev ros-diagnostic-msgs libbenchmark-dev libvisualization-msgs-dev ros-visualization-msgs catkin-lint
-  libdiagnostic-aggregator-tools python3-geometry-msgs python3-sensor-msgs python3-diagnostic-msgs
+  libdiagnostic-aggregator-tools libdiagnostic-aggregator-dev python3-geometry-msgs python3-sensor-msgs python3-diagnostic-msgs
 )
 
 act_install_deps() {
