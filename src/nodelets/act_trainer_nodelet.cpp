@@ -965,8 +965,7 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   const size_t n = window_.size();
   const double since_image = last_image_.isZero() ? -1.0 : (now - last_image_).toSec();
   const auto counts = trainer_->lut().cellCounts();
-  uint64_t filled = 0;
-  for (int k = 1; k < core::kNumClasses; ++k) filled += counts[k];
+  const uint64_t filled = trainer_->lut().mappedCells();
   fill_history_.emplace_back(now, filled);
   while (!fill_history_.empty() && (now - fill_history_.front().first).toSec() > kFillWindowS) {
     fill_history_.pop_front();

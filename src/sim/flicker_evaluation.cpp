@@ -40,10 +40,7 @@ FlickerRun playWithGains(const FamilyScene& scene, const FlickerFrames& frames, 
       run.light_changes += stats.light_change;
       run.restores += stats.light_restored;
     }
-    const auto counts = trainer.lut().cellCounts();
-    double filled = 0;
-    for (int k = 1; k < core::kNumClasses; ++k) filled += counts[k];
-    run.fill.push_back(filled / static_cast<double>(trainer.lut().size()));
+    run.fill.push_back(trainer.lut().mappedCells() / static_cast<double>(trainer.lut().size()));
     segmenter.classify(trainer.lut(), view, labels);
     run.per_frame.emplace_back();
     run.per_frame.back().add(labels, frames.frames[i].labels);

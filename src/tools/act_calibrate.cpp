@@ -17,6 +17,7 @@
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/mirror_calibrator.hpp"
 #include "act_color/sim/calibrator_check.hpp"
+#include "seed_range.hpp"
 
 namespace {
 
@@ -84,16 +85,13 @@ void printResidual(const std::string& what, const core::LineResidual& r) {
 
 // --family A-B: the calibrator on the randomized family's cameras, against their true calibration.
 int checkFamily(const std::string& range) {
-  const size_t dash = range.find('-');
-  if (dash == std::string::npos || dash == 0 || dash + 1 == range.size() ||
-      range.find_first_not_of("0123456789-") != std::string::npos) {
-    return usage("--family wants A-B (seeds), not '" + range + "'");
+  uint32_t first = 0, last = 0;
+  if (!act_color_tools::parseSeedRange(range, &first, &last, 1001)) {
+    return usage("--family wants A-B (seeds), not '" + range + "' (A <= B, at most 1001 seeds)");
   }
-  const unsigned long first = std::stoul(range.substr(0, dash)), last = std::stoul(range.substr(dash + 1));
-  if (last < first || last - first > 1000) return usage("--family: A-B with A <= B and at most 1000 seeds");
   std::vector<act_color::sim::CalibratorCheck> checks;
-  for (unsigned long seed = first; seed <= last; ++seed) {
-    checks.push_back(act_color::sim::checkCalibrator(static_cast<uint32_t>(seed)));
+  for (uint32_t seed = first; seed <= last; ++seed) {
+    checks.push_back(act_color::sim::checkCalibrator(seed));
     std::cerr << "act_calibrate: seed " << seed << (checks.back().passed() ? " within the targets\n" : " off\n");
   }
   std::cout << act_color::sim::formatCalibratorChecks(checks);

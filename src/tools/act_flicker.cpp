@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "act_color/sim/flicker_evaluation.hpp"
+#include "seed_range.hpp"
 
 namespace {
 
@@ -38,12 +39,9 @@ int main(int argc, char** argv) {
       if (arg == "--help" || arg == "-h") {
         return usage("");
       } else if (arg == "--seeds") {
-        const std::string s = value();
-        const size_t dash = s.find('-');
-        if (dash == std::string::npos) return usage("--seeds wants A-B");
-        first = static_cast<uint32_t>(std::stoul(s.substr(0, dash)));
-        last = static_cast<uint32_t>(std::stoul(s.substr(dash + 1)));
-        if (last < first) return usage("--seeds: B must not be below A");
+        if (!act_color_tools::parseSeedRange(value(), &first, &last)) {
+          return usage("--seeds wants A-B (seeds, A <= B, at most 1000 of them)");
+        }
       } else if (arg == "--frames") {
         frames = std::stoul(value());
         if (frames < kMeasuredFrom + 10 || frames > 10000) return usage("--frames must be in [40, 10000]");

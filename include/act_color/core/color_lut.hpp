@@ -37,6 +37,12 @@ class ColorLut {
 
   // Cells per class id; kept up to date by set(), clear() and assign(), so O(1).
   std::array<uint32_t, kNumClasses> cellCounts() const { return counts_; }
+  // Cells mapped to any class (the table's fill), O(1).
+  uint32_t mappedCells() const {
+    uint32_t n = 0;
+    for (int k = 1; k < kNumClasses; ++k) n += counts_[k];
+    return n;
+  }
 
   const std::vector<uint8_t>& table() const { return table_; }
   // Replaces the table; `table.size()` must equal size().
