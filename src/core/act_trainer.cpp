@@ -853,9 +853,16 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   const bool ball_lost = !ball.trained() || now - ball_last_seen_ > kBallLostCycles;
   for (const BallBlob& b : ball_blobs_) {
     if (&b == seen || !ballCandidate(b, ball_lost && ball.trained())) continue;
+    // The nearest hypothesis within the spreads of both: a blob of mixed colors (a wide spread)
+    // neither takes in nor joins a ball of one color.
     BallHypothesis* match = nullptr;
+    double nearest = std::numeric_limits<double>::infinity();
     for (BallHypothesis& h : ball_hypotheses_) {
-      if ((b.median - h.mean).norm() < std::max(kBallMatchSpreads * h.spread, kBallMatchMin)) match = &h;
+      const double distance = (b.median - h.mean).norm();
+      if (distance < std::max(kBallMatchSpreads * std::min(h.spread, b.spread), kBallMatchMin) && distance < nearest) {
+        match = &h;
+        nearest = distance;
+      }
     }
     if (!match) {
       ball_hypotheses_.push_back({b.median, b.spread, 0, now, {}});

@@ -7,7 +7,9 @@
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/ball_detector.hpp"
 #include "act_color/core/segmenter.hpp"
+#include "act_color/sim/family_evaluation.hpp"
 #include "act_color/sim/renderer.hpp"
+#include "act_color/sim/scene_family.hpp"
 #include "sim_test_util.hpp"
 
 namespace act_color {
@@ -122,6 +124,16 @@ TEST(BallTraining, NoBallNoBallPixels) {
     EXPECT_FALSE(r.trained);
     EXPECT_EQ(r.frames_with_ball_pixels, 0u);
   }
+}
+
+TEST(BallTraining, NoBallFromAMixOfColors) {
+  // Tuning scene 92 has no ball. A blob of mixed colors (spread 110) once began a hypothesis
+  // whose match radius (2.5 spreads) then took in a pink blob on the carpet, frame after frame,
+  // and seeded a ball from both: ball pixels in 28 of its 55 frames.
+  const sim::SceneResult r =
+      sim::evaluateScene(sim::makeFamilyScene(92), {{"defaults", core::ActParams()}}, sim::EvalOptions());
+  ASSERT_FALSE(r.ball.front().ball_in_scene);
+  EXPECT_EQ(r.ball.front().frames_with_ball_pixels, 0u);
 }
 
 TEST(BallTraining, OffWithOneParameter) {
