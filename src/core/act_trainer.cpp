@@ -781,6 +781,11 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   ball_known_colors_.assign(1, {clusters_[kGreen].mean().cast<float>(), static_cast<float>(green_radius * green_radius),
                                 static_cast<float>(kIntensityWeight), lut_.colorSpace() == ColorSpace::kYuv});
   ClassCluster& ball = clusters_[kOrange];
+  if (ball.trained()) {
+    const double ball_radius = params_.zeta * ball.sigma();  // 2.3's test, as addColor
+    ball_known_colors_.push_back({ball.mean().cast<float>(), static_cast<float>(ball_radius * ball_radius), 1.f,
+                                  lut_.colorSpace() == ColorSpace::kYuv, true});
+  }
   ball_detector_.detect(model_, image, lut_, sector_safe_range_, ball_known_colors_, &ball_blobs_, &ball_off_field_,
                         static_cast<uint32_t>(revision_), ball.trained() && params_.evidence_removal_ratio > 0);
   const uint32_t now = static_cast<uint32_t>(revision_ + 1);

@@ -127,6 +127,8 @@ uint8_t BallDetector::classOf(const ColorLut& lut, const std::vector<KnownColor>
   const uint8_t k = lut.classOf(c[0], c[1], c[2]);
   if (k != kUnknown) return k;
   const Eigen::Vector3f color(c[0], c[1], c[2]);
+  const KnownColor* nearest = nullptr;
+  float nearest_ratio = 1.f;  // squared distance over squared radius
   for (const KnownColor& known : known_colors) {
     const Eigen::Vector3f d = color - known.mean;
     float sq = d.squaredNorm();
@@ -136,9 +138,12 @@ uint8_t BallDetector::classOf(const ColorLut& lut, const std::vector<KnownColor>
       const float sum = d.sum();
       sq -= (1.f - known.intensity_weight) * sum * sum / 3.f;
     }
-    if (sq < known.radius_sq) return kGreen;  // not the ball's
+    if (sq < nearest_ratio * known.radius_sq) {
+      nearest = &known;
+      nearest_ratio = sq / known.radius_sq;
+    }
   }
-  return kUnknown;
+  return nearest && !nearest->ball ? kGreen : kUnknown;  // kGreen: known, not the ball's
 }
 
 void BallDetector::detect(const ExpectedClassModel& model, const ImageView& image, const ColorLut& lut,

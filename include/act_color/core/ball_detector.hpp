@@ -70,11 +70,16 @@ class BallDetector {
   // A color a trained class's cluster includes: pixels unknown to the table but of such a color
   // (the carpet in a shadow not yet trained) are not the ball's. The distance weighs the intensity
   // difference by `intensity_weight` (as the trainer's nearest-mean rule): a darker carpet is carpet.
+  // An unknown color that several include belongs to the one it is nearest to in units of their
+  // radii; the ball's own cluster may be one of them (`ball`): its colors stay the ball's. (After
+  // the paper's darkening a light ball's colors lie within the carpet's radius, which does not
+  // shrink below zeta sigma_min, and the ball was never seen again.)
   struct KnownColor {
     Eigen::Vector3f mean;
     float radius_sq;
     float intensity_weight = 1.f;
-    bool yuv = false;  // channel 0 is the intensity; else it is the channels' mean
+    bool yuv = false;   // channel 0 is the intensity; else it is the channels' mean
+    bool ball = false;  // the ball's cluster
   };
   // Blobs of this image at this pose; `sector_safe_range` from ExpectedClassModel::sectorSafeRanges.
   // Blobs far larger than any ball image are skipped.
