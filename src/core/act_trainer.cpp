@@ -21,6 +21,10 @@ void requireRange(const char* name, double value, double lo, double hi, bool lo_
 
 // Weight of the intensity difference in the nearest-mean rule (ActParams::nearest_mean).
 constexpr double kIntensityWeight = 0.1;
+// robots_train_black: dark is below this fraction of the carpet's intensity (ActTrainer::darkLimit);
+// the chassis and the carpet must be this far apart (sum of the channels) to carry it on.
+constexpr double kDarkFraction = 0.6;
+constexpr double kMinAnchorSpan = 15.0;
 
 // A cell confirmed again within this many cycles does not fill its neighbourhood again.
 constexpr uint32_t kNeighbourhoodRefreshCycles = 8;
@@ -225,6 +229,8 @@ void ActTrainer::reset(ColorSpace space) {
   evidence_.assign(lut_.size(), Evidence{});
   for (auto& cluster : clusters_) cluster.reset(255.0);
   light_.reset();
+  dark_position_ = -1;
+  dark_frozen_ = false;
   light_states_.clear();
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
@@ -262,6 +268,8 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   neighbour_only_.assign(lut_.size(), 0);
   evidence_.assign(lut_.size(), Evidence{});
   light_.reset();
+  dark_position_ = -1;
+  dark_frozen_ = false;
   light_states_.clear();
   space_known_ = true;
 }
@@ -373,9 +381,19 @@ uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
   const int lo = std::min({c[0], c[1], c[2]});
   const int hi = std::max({c[0], c[1], c[2]});
   const double intensity = c[0] + c[1] + c[2];
-  if (intensity >= 0.6 * green.mean().sum() || hi - lo > 0.35 * hi + 8) return k;
+  if (intensity >= darkLimit() || hi - lo > 0.35 * hi + 8) return k;
   const Eigen::Vector3d color(c[0], c[1], c[2]);
   return (color - green.mean()).norm() > params_.zeta * green.sigma() ? static_cast<uint8_t>(kBlack) : k;
+}
+
+double ActTrainer::darkLimit() const {
+  // 60% of the carpet's intensity in the light before the first change, as a position between the
+  // own chassis and the carpet (which a change of gain, brightness and contrast keeps): the paper's
+  // darkening lifts black, and at 60% of green's intensity alone no robot trained black after it
+  // (tuning scenes 10, 70, 73).
+  const double green = clusters_[kGreen].mean().sum();
+  if (!(dark_position_ >= 0) || green - chassis_intensity_ < kMinAnchorSpan) return kDarkFraction * green;
+  return chassis_intensity_ + dark_position_ * (green - chassis_intensity_);
 }
 
 void ActTrainer::prepareNearestMean() {
@@ -620,6 +638,24 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     }
   };
 
+  // The own chassis's median intensity: the black of this light (robots_train_black).
+  chassis_intensity_ = 0;
+  if (!chassis_pixels_.empty()) {
+    std::vector<double>& values = chassis_intensities_;
+    values.clear();
+    for (const uint32_t i : chassis_pixels_) {
+      uint8_t c[3];
+      image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
+      values.push_back(c[0] + c[1] + c[2]);
+    }
+    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+    chassis_intensity_ = values[values.size() / 2];
+    const double green = clusters_[kGreen].mean().sum();
+    if (!dark_frozen_ && clusters_[kGreen].trained() && green - chassis_intensity_ >= kMinAnchorSpan) {
+      dark_position_ = (kDarkFraction * green - chassis_intensity_) / (green - chassis_intensity_);
+    }
+  }
+
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
   chassis_samples_.clear();
@@ -670,6 +706,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   if (light_changed && restoreLightState()) {
     light_changed = false;
     stats.light_restored = true;
+    dark_frozen_ = true;
   } else if (light_changed) {
     light_changed = light_.estimate(lut_.colorSpace(), &light_map);
   }
@@ -684,6 +721,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     applyLightChange(light_map);
     light_.rebase(light_map);
     stats.light_change = true;
+    dark_frozen_ = true;
   } else if (params_.light_compensation) {
     light_.follow(params_.eta);
   }

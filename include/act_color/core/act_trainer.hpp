@@ -55,8 +55,9 @@ struct ActParams {
   int removal_protect_cycles = 10;
   // Black is the own chassis and the other robots, but the chassis alone is lit differently from
   // robots elsewhere on the field: a color expected green or a goal that is far from green (beyond
-  // zeta * sigma), dark (intensity below 60% of green's) and unsaturated is a robot standing on
-  // the carpet or in front of a goal and trains black instead.
+  // zeta * sigma), dark (intensity below 60% of green's in the light before the first change, a
+  // limit carried through changes by its place between the own chassis and the carpet) and
+  // unsaturated is a robot standing on the carpet or in front of a goal and trains black instead.
   bool robots_train_black = true;
   // A color joins class k only when k's cluster mean is the nearest of the trained clusters'
   // means: the table splits mixed colors (the blurred edge of a line on the carpet) where they are
@@ -188,6 +189,8 @@ class ActTrainer {
   // Returns true when it restored one (the state left is kept in its place).
   bool restoreLightState();
   void keepLightState();
+  // robots_train_black's intensity below which a color is dark, in this cycle's light.
+  double darkLimit() const;
   // The ball stage (ActParams::ball_training), after 2.3; needs sector_safe_range_ of the pose.
   void trainBall(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
 
@@ -229,6 +232,12 @@ class ActTrainer {
   std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> anchor_samples_;  // scratch of a denser look
   std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, about 192
+  double chassis_intensity_ = 0;          // this cycle's median over them (sum of the channels)
+  std::vector<double> chassis_intensities_;
+  // darkLimit's position between the chassis (0) and the carpet (1), taken until the first change
+  // of light; -1 unset.
+  double dark_position_ = -1;
+  bool dark_frozen_ = false;
   LightModel light_;
   std::vector<uint8_t> warped_;
   // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.
