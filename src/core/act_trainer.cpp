@@ -177,6 +177,8 @@ void ActParams::set(const std::string& name, const std::string& value) {
     nearest_mean = boolean();
   } else if (name == "evidence_removal_ratio") {
     evidence_removal_ratio = number();
+  } else if (name == "learned_boundary") {
+    learned_boundary = boolean();
   } else if (name == "ball_training") {
     ball_training = boolean();
   } else if (name == "ball_diameter_m") {
@@ -193,6 +195,7 @@ void ActParams::switchOffExtensions() {
   robots_train_black = false;
   nearest_mean = false;
   evidence_removal_ratio = 0;
+  learned_boundary = false;
   ball_training = false;
 }
 
@@ -234,6 +237,7 @@ void ActTrainer::reset(ColorSpace space) {
   light_states_.clear();
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
+  forgetBoundary();
   space_known_ = true;
 }
 
@@ -368,6 +372,125 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   return changed;
 }
 
+namespace {
+
+// ActParams::learned_boundary: carpet pixels within this distance of a line pixel count; every
+// n-th pixel is looked at; the axis's range that is counted; the counts' half-life.
+constexpr int kBoundaryPixels = 2;
+constexpr int kBoundaryStride = 25;
+constexpr double kBoundaryLow = -0.25, kBoundaryHigh = 1.25;
+constexpr double kBoundaryHalfLifeCycles = 40.0;
+// The axis's weighted metric (the nearest-mean rule's).
+Eigen::Matrix3d meanMetric(ColorSpace space);
+
+}  // namespace
+
+void ActTrainer::forgetBoundary() {
+  boundary_line_.fill(0.f);
+  boundary_carpet_.fill(0.f);
+  boundary_t_ = 0.5;
+}
+
+void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats) {
+  const ClassCluster& green = clusters_[kGreen];
+  const ClassCluster& white = clusters_[kWhite];
+  if (!green.trained() || !white.trained()) return;
+  const Eigen::Matrix3d a = meanMetric(lut_.colorSpace());
+  const Eigen::Vector3d axis = white.mean() - green.mean();
+  const double length_sq = axis.dot(a * axis);
+  if (!(length_sq > 1.0)) return;
+  const Eigen::Vector3d dir = a * axis / length_sq;  // t(c) = (c - green) . dir
+  const double t0 = -green.mean().dot(dir);
+  const float decay = static_cast<float>(std::pow(0.5, 1.0 / kBoundaryHalfLifeCycles));
+  for (int b = 0; b < kBoundaryBins; ++b) {
+    boundary_line_[b] *= decay;
+    boundary_carpet_[b] *= decay;
+  }
+  const int width = image.width, height = image.height;
+  const size_t pixels = static_cast<size_t>(width) * height;
+  const double bin_width = (kBoundaryHigh - kBoundaryLow) / kBoundaryBins;
+  // Off the axis by more than white's and green's spread: another class's color.
+  const double off_axis_sq = std::pow(params_.zeta * std::max(green.sigma(), white.sigma()), 2);
+  const double unit_sq = axis.squaredNorm();
+  // The largest t in the cell of c: t at the cell's centre plus half its extent along the axis.
+  const int shift = 8 - lut_.bitsPerChannel();
+  const double half = 0.5 * (1 << shift);
+  const double cell_reach = half * dir.cwiseAbs().sum();
+  auto cellTop = [&](const uint8_t col[3]) {
+    const Eigen::Vector3d centre(((col[0] >> shift) << shift) + half, ((col[1] >> shift) << shift) + half,
+                                 ((col[2] >> shift) << shift) + half);
+    return t0 + centre.dot(dir) + cell_reach;
+  };
+  // The start moves on each cycle (not drawn from rng_: the other steps' samples stay as they were).
+  for (StridedPixels p(static_cast<size_t>(revision_ * 7 % kBoundaryStride), kBoundaryStride, width); p.i < pixels;
+       p.next()) {
+    uint8_t c[3];
+    image.color(p.u, p.v, c);
+    const Eigen::Vector3d color(c[0], c[1], c[2]);
+    const double t = t0 + color.dot(dir);
+    if (!(t >= kBoundaryLow && t < kBoundaryHigh)) continue;
+    // Green's and white's mixtures lie near the axis.
+    const Eigen::Vector3d off = color - green.mean() - t * axis;
+    if (off.squaredNorm() > off_axis_sq && off.squaredNorm() > 0.05 * unit_sq) continue;
+    // A mixture on the carpet's side of the split is not white: its cell is removed when all of
+    // it lies there (a cell across the split would be added by its white colors and removed by its
+    // others, cycle after cycle).
+    const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+    if (lut_.at(cell) == kWhite && cellTop(c) < boundary_t_) {
+      removeCell(cell);
+      confirmed_[cell] = 0;
+      ++stats.removed[kWhite];
+    }
+    const uint8_t k = model_.geometricClass(p.i, transform);
+    bool line = false;
+    if (k == kWhite) {
+      if (params_.white_filter && !ExpectedClassModel::brighterThanNeighbourhood(image, p.u, p.v)) continue;
+      line = true;
+    } else if (k == kGreen) {
+      bool next_to_line = false;
+      for (int d = 1; d <= kBoundaryPixels && !next_to_line; ++d) {
+        const int du[4] = {d, -d, 0, 0}, dv[4] = {0, 0, d, -d};
+        for (int n = 0; n < 4 && !next_to_line; ++n) {
+          const int x = p.u + du[n], y = p.v + dv[n];
+          if (x < 0 || y < 0 || x >= width || y >= height) continue;
+          next_to_line = model_.geometricClass(static_cast<size_t>(y) * width + x, transform) == kWhite;
+        }
+      }
+      if (!next_to_line) continue;
+    } else {
+      continue;
+    }
+    const int bin = std::clamp(static_cast<int>((t - kBoundaryLow) / bin_width), 0, kBoundaryBins - 1);
+    (line ? boundary_line_ : boundary_carpet_)[bin] += 1.f;
+  }
+  // The split with the fewest of the model's pixels on the wrong side: carpet above it, lines below.
+  float carpet_above = 0.f, line_total = 0.f;
+  for (int b = 0; b < kBoundaryBins; ++b) {
+    carpet_above += boundary_carpet_[b];
+    line_total += boundary_line_[b];
+  }
+  if (line_total < 20.f) return;
+  // Of equally good splits (a gap between the two), the middle one.
+  std::array<float, kBoundaryBins + 1> wrong{};
+  wrong[0] = carpet_above;  // split below every bin: all carpet on the wrong side
+  float line_below = 0.f;
+  for (int b = 0; b < kBoundaryBins; ++b) {
+    carpet_above -= boundary_carpet_[b];
+    line_below += boundary_line_[b];
+    wrong[b + 1] = carpet_above + line_below;
+  }
+  const float fewest = *std::min_element(wrong.begin(), wrong.end());
+  const float tolerance = 1e-3f * line_total;
+  int first = kBoundaryBins, last = 0;
+  for (int b = 0; b <= kBoundaryBins; ++b) {
+    if (wrong[b] <= fewest + tolerance) {
+      first = std::min(first, b);
+      last = std::max(last, b);
+    }
+  }
+  boundary_t_ = std::clamp(kBoundaryLow + 0.5 * (first + last) * bin_width, 0.05, 0.95);
+}
+
 double ActTrainer::evidenceRatio(uint8_t k) const {
   return k == kOrange ? std::min(params_.evidence_removal_ratio, kBallEvidenceRatio) : params_.evidence_removal_ratio;
 }
@@ -396,6 +519,18 @@ double ActTrainer::darkLimit() const {
   return chassis_intensity_ + dark_position_ * (green - chassis_intensity_);
 }
 
+namespace {
+Eigen::Matrix3d meanMetric(ColorSpace space) {
+  Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
+  if (space == ColorSpace::kYuv) {
+    a(0, 0) = kIntensityWeight;
+  } else {
+    a -= Eigen::Matrix3d::Constant((1.0 - kIntensityWeight) / 3.0);
+  }
+  return a;
+}
+}  // namespace
+
 void ActTrainer::prepareNearestMean() {
   for (auto& boundaries : mean_boundaries_) boundaries.clear();
   if (!params_.nearest_mean) return;
@@ -404,12 +539,7 @@ void ActTrainer::prepareNearestMean() {
   // classes is split at its middle. In YUV A = diag(w, 1, 1); in RGB A = I - (1 - w) / 3 J (J: all
   // ones), which removes 1 - w of the squared intensity difference (sum / 3) times 3.
   // Mean j is nearer than mean k when 2 c' A (m_k - m_j) < m_k' A m_k - m_j' A m_j.
-  Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
-  if (lut_.colorSpace() == ColorSpace::kYuv) {
-    a(0, 0) = kIntensityWeight;
-  } else {
-    a -= Eigen::Matrix3d::Constant((1.0 - kIntensityWeight) / 3.0);
-  }
+  const Eigen::Matrix3d a = meanMetric(lut_.colorSpace());
   for (int k = 1; k < kNumClasses; ++k) {
     const Eigen::Vector3d& own = clusters_[k].mean();
     for (int j = 1; j < kNumClasses; ++j) {
@@ -417,6 +547,16 @@ void ActTrainer::prepareNearestMean() {
       // The goal region decides between a goal and the ball: the ball's mean takes no goal color.
       if (j == kOrange && (k == kYellow || k == kBlue)) continue;
       const Eigen::Vector3d& other = clusters_[j].mean();
+      // The middle between the means, or for the carpet and the lines the learned split: the plane
+      // normal to the axis (in the metric) through green + t (white - green).
+      const bool pair = (k == kGreen && j == kWhite) || (k == kWhite && j == kGreen);
+      if (pair && params_.learned_boundary) {
+        const double t = k == kGreen ? boundary_t_ : 1.0 - boundary_t_;
+        const Eigen::Vector3d split = own + t * (other - own);
+        const Eigen::Vector3d normal = a * (own - other);
+        mean_boundaries_[k].push_back({normal, normal.dot(split)});
+        continue;
+      }
       mean_boundaries_[k].push_back({2.0 * a * (own - other), own.dot(a * own) - other.dot(a * other)});
     }
   }
@@ -731,6 +871,9 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
   }
 
+  // The split was counted in the old light's colors: it is learned again in the new one.
+  if (stats.light_change || stats.light_restored) forgetBoundary();
+  if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
   const int add_stride =
       stats.light_change ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;

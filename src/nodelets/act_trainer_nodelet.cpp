@@ -233,6 +233,7 @@ bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) 
                     readParam(pnh_, "robots_train_black", &p.robots_train_black, error) &&
                     readParam(pnh_, "nearest_mean", &p.nearest_mean, error) &&
                     readParam(pnh_, "evidence_removal_ratio", &p.evidence_removal_ratio, error) &&
+                    readParam(pnh_, "learned_boundary", &p.learned_boundary, error) &&
                     readParam(pnh_, "ball_training", &p.ball_training, error) &&
                     readParam(pnh_, "ball_diameter_m", &p.ball_diameter_m, error);
   if (!read) return false;
@@ -450,6 +451,7 @@ ActTrainerConfig ActTrainerNodelet::configInEffect() const {
   c.robots_train_black = p.robots_train_black;
   c.nearest_mean = p.nearest_mean;
   c.evidence_removal_ratio = p.evidence_removal_ratio;
+  c.learned_boundary = p.learned_boundary;
   c.ball_training = p.ball_training;
   c.ball_diameter_m = p.ball_diameter_m;
   c.max_pose_age = max_pose_age_s_;
@@ -477,6 +479,7 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
   p.robots_train_black = c.robots_train_black;
   p.nearest_mean = c.nearest_mean;
   p.evidence_removal_ratio = c.evidence_removal_ratio;
+  p.learned_boundary = c.learned_boundary;
   p.ball_training = c.ball_training;
   p.ball_diameter_m = c.ball_diameter_m;
   try {

@@ -97,6 +97,7 @@ std::vector<EvalMode> evalModes(bool ablations) {
       {"robots_train_black", [](core::ActParams& p) { p.robots_train_black = false; }},
       {"nearest_mean", [](core::ActParams& p) { p.nearest_mean = false; }},
       {"evidence_removal_ratio", [](core::ActParams& p) { p.evidence_removal_ratio = 0; }},
+      {"learned_boundary", [](core::ActParams& p) { p.learned_boundary = false; }},
   };
   for (const auto& [name, apply] : off) {
     EvalMode m{"no_" + name, core::ActParams()};

@@ -458,6 +458,7 @@ TEST_F(ActTrainerTest, MixedColorsJoinTheClassWhoseMeanIsNearer) {
   const auto clean = paintFlatFrame(model, pose, 1.0, 1);
   ActParams p;
   p.add_neighbourhood_cells = 0;
+  p.learned_boundary = false;  // the split in the middle between the means (see the next test)
   ActTrainer trainer(cal, p);
   trainer.bootstrap(view(clean.rgb), pose, 40);
   const Eigen::Vector3d white = trainer.clusters()[kWhite].mean(), green = trainer.clusters()[kGreen].mean();
@@ -495,6 +496,64 @@ TEST_F(ActTrainerTest, MixedColorsJoinTheClassWhoseMeanIsNearer) {
   // Without the rule zeta alone decides: the mostly-green mixture becomes white.
   const ColorLut without = trainOnce(false);
   EXPECT_EQ(without.classOf(mostly_green[0], mostly_green[1], mostly_green[2]), kWhite);
+}
+
+TEST_F(ActTrainerTest, TheCarpetAndTheLinesSplitWhereTheFieldModelSaysTheyMeet) {
+  // A blur wider than the lines: the carpet pixels next to a line (1 px) show a mixture that is 60%
+  // white, the line pixels one that is 90% white, and a third of the line's own edge the same 60%
+  // one: the mixture is more often carpet than line. The middle between the means makes it white; the split learned
+  // from the model's pixels on both sides leaves it out of white and keeps the 90% one.
+  const auto clean = paintFlatFrame(model, pose, 1.0, 1);
+  ActParams p;
+  p.add_neighbourhood_cells = 0;
+  ActTrainer trainer(cal, p);
+  trainer.bootstrap(view(clean.rgb), pose, 40);
+  const Eigen::Vector3d white = trainer.clusters()[kWhite].mean(), green = trainer.clusters()[kGreen].mean();
+  const cv::Vec3b edge = mix(white, green, 0.6), line = mix(white, green, 0.9);
+  cv::Mat frame = clean.rgb.clone();
+  const PoseTransform t(pose);
+  auto geometric = [&](int u, int v) {
+    return u < 0 || v < 0 || u >= 580 || v >= 580 ? kNotImaged : model.geometricClass(v * 580 + u, t);
+  };
+  int edges = 0, mixed_lines = 0;
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      const uint8_t k = geometric(u, v);
+      if (k == kWhite) {
+        const bool line_edge = geometric(u + 1, v) == kGreen || geometric(u - 1, v) == kGreen ||
+                               geometric(u, v + 1) == kGreen || geometric(u, v - 1) == kGreen;
+        const bool mixed = line_edge && (u + v) % 3 == 0;
+        frame.at<cv::Vec3b>(v, u) = mixed ? edge : line;
+        mixed_lines += mixed;
+      }
+      const bool next_to_line = geometric(u + 1, v) == kWhite || geometric(u - 1, v) == kWhite ||
+                                geometric(u, v + 1) == kWhite || geometric(u, v - 1) == kWhite;
+      if (k == kGreen && next_to_line) {
+        frame.at<cv::Vec3b>(v, u) = edge;
+        ++edges;
+      }
+    }
+  }
+  ASSERT_GT(edges, 2 * mixed_lines);
+  auto train = [&](bool learned) {
+    ActTrainer copy = trainer;
+    ActParams q = p;
+    q.zeta = 40.0;
+    q.white_filter = false;
+    q.add_stride = 1;
+    q.cluster_stride = 1 << 20;  // the means stay those of the clean frame
+    q.remove_stride = 1 << 20;
+    q.learned_boundary = learned;
+    copy.setParams(q);
+    for (int i = 0; i < 3; ++i) copy.cycle(view(frame), pose);
+    return copy.lut();
+  };
+  const ColorLut with = train(true);
+  EXPECT_NE(with.classOf(edge[0], edge[1], edge[2]), kWhite);
+  EXPECT_EQ(with.classOf(line[0], line[1], line[2]), kWhite);
+  const ColorLut without = train(false);
+  EXPECT_EQ(without.classOf(edge[0], edge[1], edge[2]), kWhite);
+  EXPECT_EQ(without.classOf(line[0], line[1], line[2]), kWhite);
 }
 
 TEST_F(ActTrainerTest, ColorsSeenMoreOftenOffTheFieldThanInItAreRemovedWithinXiSigma) {

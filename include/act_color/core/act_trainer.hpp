@@ -72,6 +72,13 @@ struct ActParams {
   // color (on a real image brightened 1.5x the rule took white's saturated cell and lost 80% of the
   // line pixels). 0: off.
   double evidence_removal_ratio = 3.0;
+  // Where the carpet meets a line the image shows mixed colors (blur, a line narrower than a
+  // pixel), and the field model says which side of the boundary each pixel lies on. Along the axis
+  // from green's mean to white's, the colors of the pixels the model puts on the line (eq. 1) and of
+  // the carpet pixels next to it are counted, and the nearest-mean rule splits the two classes where
+  // the model's pixels change from one to the other (fewest pixels on the wrong side) instead of at
+  // the middle between the means; white's cells on the carpet's side are removed when seen.
+  bool learned_boundary = true;
   // Beyond the paper, which leaves the ball out (2.1): the ball's color is learned from its shape.
   // Compact blobs on the carpet of the image size a sphere of ball_diameter_m has at their
   // distance, surrounded by carpet and of a color no trained class has, are ball candidates; a
@@ -178,6 +185,9 @@ class ActTrainer {
   // The class a sample expected as k trains (robots_train_black re-routes green and goal colors
   // of robots to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
+  // ActParams::learned_boundary: counts this cycle's pixels near the carpet-line boundary.
+  void learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
+  void forgetBoundary();
   // ActParams::evidence_removal_ratio for class k (lower for the ball).
   double evidenceRatio(uint8_t k) const;
   // Light compensation: the map moves every cluster and every table cell.
@@ -226,6 +236,13 @@ class ActTrainer {
     double offset;
   };
   std::array<std::vector<MeanBoundary>, kNumClasses> mean_boundaries_;
+  // ActParams::learned_boundary: decayed counts of line (eq. 1) and carpet pixels next to a line by
+  // their position t along the axis from green's mean (0) to white's (1), kBoundaryBins bins over
+  // [kBoundaryLow, kBoundaryHigh); the split position learned from them (0.5: the middle).
+  static constexpr int kBoundaryBins = 40;
+  std::array<float, kBoundaryBins> boundary_line_{};
+  std::array<float, kBoundaryBins> boundary_carpet_{};
+  double boundary_t_ = 0.5;
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
   std::vector<Eigen::Vector3f> carpet_samples_;   // expected green, before robots_train_black: an anchor
