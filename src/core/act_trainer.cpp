@@ -375,10 +375,14 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
 namespace {
 
 // ActParams::learned_boundary: carpet pixels within this distance of a line pixel count; every
-// n-th pixel is looked at; the axis's range that is counted; the counts' half-life.
+// n-th pixel is looked at; the axis's range whose mixtures may lose white; the range the split may
+// take, which is also the range that is counted (a pixel outside it is on the same side of every
+// split, and the field model's class is not looked up for it: most of the carpet); the counts'
+// half-life.
 constexpr int kBoundaryPixels = 2;
-constexpr int kBoundaryStride = 25;
-constexpr double kBoundaryLow = -0.25, kBoundaryHigh = 1.25;
+constexpr int kBoundaryStride = 400;
+constexpr double kMixtureLow = -0.25, kMixtureHigh = 1.25;
+constexpr double kBoundaryLow = 0.05, kBoundaryHigh = 0.95;
 constexpr double kBoundaryHalfLifeCycles = 40.0;
 // The axis's weighted metric (the nearest-mean rule's).
 Eigen::Matrix3d meanMetric(ColorSpace space);
@@ -428,7 +432,7 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
     image.color(p.u, p.v, c);
     const Eigen::Vector3d color(c[0], c[1], c[2]);
     const double t = t0 + color.dot(dir);
-    if (!(t >= kBoundaryLow && t < kBoundaryHigh)) continue;
+    if (!(t >= kMixtureLow && t < kMixtureHigh)) continue;
     // Green's and white's mixtures lie near the axis.
     const Eigen::Vector3d off = color - green.mean() - t * axis;
     if (off.squaredNorm() > off_axis_sq && off.squaredNorm() > 0.05 * unit_sq) continue;
@@ -441,6 +445,7 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
       confirmed_[cell] = 0;
       ++stats.removed[kWhite];
     }
+    if (!(t >= kBoundaryLow && t < kBoundaryHigh)) continue;
     const uint8_t k = model_.geometricClass(p.i, transform);
     bool line = false;
     if (k == kWhite) {
@@ -488,7 +493,7 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
       last = std::max(last, b);
     }
   }
-  boundary_t_ = std::clamp(kBoundaryLow + 0.5 * (first + last) * bin_width, 0.05, 0.95);
+  boundary_t_ = kBoundaryLow + 0.5 * (first + last) * bin_width;
 }
 
 double ActTrainer::evidenceRatio(uint8_t k) const {

@@ -239,7 +239,7 @@ class ActTrainer {
   // ActParams::learned_boundary: decayed counts of line (eq. 1) and carpet pixels next to a line by
   // their position t along the axis from green's mean (0) to white's (1), kBoundaryBins bins over
   // [kBoundaryLow, kBoundaryHigh); the split position learned from them (0.5: the middle).
-  static constexpr int kBoundaryBins = 40;
+  static constexpr int kBoundaryBins = 24;
   std::array<float, kBoundaryBins> boundary_line_{};
   std::array<float, kBoundaryBins> boundary_carpet_{};
   double boundary_t_ = 0.5;
