@@ -876,8 +876,6 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
   }
 
-  // The split was counted in the old light's colors: it is learned again in the new one.
-  if (stats.light_change || stats.light_restored) forgetBoundary();
   if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
   const int add_stride =
