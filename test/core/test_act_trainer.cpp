@@ -448,6 +448,17 @@ cv::Vec3b mix(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double share_o
                    static_cast<uint8_t>(std::lround(c[2])));
 }
 
+// `p` for a look at one frame's colors: every pixel added, wide clusters, no eq. 1, and no cluster
+// update or removal: the means stay those the trainer had.
+ActParams everyPixelAtFixedMeans(ActParams q) {
+  q.zeta = 40.0;
+  q.white_filter = false;
+  q.add_stride = 1;
+  q.cluster_stride = 1 << 20;
+  q.remove_stride = 1 << 20;
+  return q;
+}
+
 }  // namespace
 
 TEST_F(ActTrainerTest, MixedColorsJoinTheClassWhoseMeanIsNearer) {
@@ -478,12 +489,7 @@ TEST_F(ActTrainerTest, MixedColorsJoinTheClassWhoseMeanIsNearer) {
   }
   auto trainOnce = [&](bool nearest_mean) {
     ActTrainer copy = trainer;
-    ActParams q = p;
-    q.zeta = 40.0;
-    q.white_filter = false;
-    q.add_stride = 1;
-    q.cluster_stride = 1 << 20;  // no cluster update: the means stay those of the clean frame
-    q.remove_stride = 1 << 20;
+    ActParams q = everyPixelAtFixedMeans(p);
     q.nearest_mean = nearest_mean;
     copy.setParams(q);
     copy.cycle(view(frame), pose);
@@ -537,12 +543,7 @@ TEST_F(ActTrainerTest, TheCarpetAndTheLinesSplitWhereTheFieldModelSaysTheyMeet) 
   ASSERT_GT(edges, 2 * mixed_lines);
   auto train = [&](bool learned) {
     ActTrainer copy = trainer;
-    ActParams q = p;
-    q.zeta = 40.0;
-    q.white_filter = false;
-    q.add_stride = 1;
-    q.cluster_stride = 1 << 20;  // the means stay those of the clean frame
-    q.remove_stride = 1 << 20;
+    ActParams q = everyPixelAtFixedMeans(p);
     q.learned_boundary = learned;
     copy.setParams(q);
     for (int i = 0; i < 3; ++i) copy.cycle(view(frame), pose);
