@@ -237,7 +237,9 @@ void ActTrainer::reset(ColorSpace space) {
   light_states_.clear();
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
-  forgetBoundary();
+  boundary_line_.fill(0.f);
+  boundary_carpet_.fill(0.f);
+  boundary_t_ = 0.5;
   space_known_ = true;
 }
 
@@ -384,16 +386,20 @@ constexpr int kBoundaryStride = 400;
 constexpr double kMixtureLow = -0.25, kMixtureHigh = 1.25;
 constexpr double kBoundaryLow = 0.05, kBoundaryHigh = 0.95;
 constexpr double kBoundaryHalfLifeCycles = 40.0;
-// The axis's weighted metric (the nearest-mean rule's).
-Eigen::Matrix3d meanMetric(ColorSpace space);
+// The nearest-mean rule's metric A: the squared distance (c - m)' A (c - m) weighs intensity
+// differences by kIntensityWeight. In YUV A = diag(w, 1, 1); in RGB A = I - (1 - w) / 3 J (J: all
+// ones), which removes 1 - w of the squared intensity difference (sum / 3) times 3.
+Eigen::Matrix3d meanMetric(ColorSpace space) {
+  Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
+  if (space == ColorSpace::kYuv) {
+    a(0, 0) = kIntensityWeight;
+  } else {
+    a -= Eigen::Matrix3d::Constant((1.0 - kIntensityWeight) / 3.0);
+  }
+  return a;
+}
 
 }  // namespace
-
-void ActTrainer::forgetBoundary() {
-  boundary_line_.fill(0.f);
-  boundary_carpet_.fill(0.f);
-  boundary_t_ = 0.5;
-}
 
 void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats) {
   const ClassCluster& green = clusters_[kGreen];
@@ -434,8 +440,8 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
     const double t = t0 + color.dot(dir);
     if (!(t >= kMixtureLow && t < kMixtureHigh)) continue;
     // Green's and white's mixtures lie near the axis.
-    const Eigen::Vector3d off = color - green.mean() - t * axis;
-    if (off.squaredNorm() > off_axis_sq && off.squaredNorm() > 0.05 * unit_sq) continue;
+    const double off_sq = (color - green.mean() - t * axis).squaredNorm();
+    if (off_sq > off_axis_sq && off_sq > 0.05 * unit_sq) continue;
     // A mixture on the carpet's side of the split is not white: its cell is removed when all of
     // it lies there (a cell across the split would be added by its white colors and removed by its
     // others, cycle after cycle).
@@ -524,25 +530,12 @@ double ActTrainer::darkLimit() const {
   return chassis_intensity_ + dark_position_ * (green - chassis_intensity_);
 }
 
-namespace {
-Eigen::Matrix3d meanMetric(ColorSpace space) {
-  Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
-  if (space == ColorSpace::kYuv) {
-    a(0, 0) = kIntensityWeight;
-  } else {
-    a -= Eigen::Matrix3d::Constant((1.0 - kIntensityWeight) / 3.0);
-  }
-  return a;
-}
-}  // namespace
-
 void ActTrainer::prepareNearestMean() {
   for (auto& boundaries : mean_boundaries_) boundaries.clear();
   if (!params_.nearest_mean) return;
-  // The rule's squared distance is (c - m)' A (c - m), the intensity difference weighted by
-  // kIntensityWeight: a line in a shadow stays nearer to white than to green, a mixture of two
-  // classes is split at its middle. In YUV A = diag(w, 1, 1); in RGB A = I - (1 - w) / 3 J (J: all
-  // ones), which removes 1 - w of the squared intensity difference (sum / 3) times 3.
+  // The rule's squared distance is (c - m)' A (c - m) (meanMetric), the intensity difference
+  // weighted by kIntensityWeight: a line in a shadow stays nearer to white than to green, a mixture
+  // of two classes is split at its middle.
   // Mean j is nearer than mean k when 2 c' A (m_k - m_j) < m_k' A m_k - m_j' A m_j.
   const Eigen::Matrix3d a = meanMetric(lut_.colorSpace());
   for (int k = 1; k < kNumClasses; ++k) {

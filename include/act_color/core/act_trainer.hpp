@@ -77,7 +77,7 @@ struct ActParams {
   // from green's mean to white's, the colors of the pixels the model puts on the line (eq. 1) and of
   // the carpet pixels next to it are counted, and the nearest-mean rule splits the two classes where
   // the model's pixels change from one to the other (fewest pixels on the wrong side) instead of at
-  // the middle between the means; white's cells on the carpet's side are removed when seen.
+  // the middle between the means; white's cells wholly on the carpet's side are removed when seen.
   bool learned_boundary = true;
   // Beyond the paper, which leaves the ball out (2.1): the ball's color is learned from its shape.
   // Compact blobs on the carpet of the image size a sphere of ball_diameter_m has at their
@@ -185,9 +185,9 @@ class ActTrainer {
   // The class a sample expected as k trains (robots_train_black re-routes green and goal colors
   // of robots to black).
   uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
-  // ActParams::learned_boundary: counts this cycle's pixels near the carpet-line boundary.
+  // ActParams::learned_boundary: counts this cycle's pixels near the carpet-line boundary, learns
+  // the split from the counts and removes the white cells that lie wholly on the carpet's side.
   void learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
-  void forgetBoundary();
   // ActParams::evidence_removal_ratio for class k (lower for the ball).
   double evidenceRatio(uint8_t k) const;
   // Light compensation: the map moves every cluster and every table cell.
