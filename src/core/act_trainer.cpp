@@ -1061,13 +1061,17 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
     }
     ++match->frames;
     match->last_seen = now;
+    match->log_radial += std::log(b.radial_ratio);
+    match->log_tangential += std::log(b.tangential_ratio);
     const Eigen::Vector2d place(b.base_x_m, b.base_y_m);
     bool new_place = match->places.size() < static_cast<size_t>(kBallSeedPlaces);
     for (const Eigen::Vector2d& q : match->places) new_place = new_place && (q - place).norm() >= kBallPlaceSpacingM;
     if (new_place) match->places.push_back(place);
+    const double max_log_extent = std::log(kBallSeedMaxMeanExtent) * match->frames;
     const bool enough =
         match->frames >= kBallSeedFrames &&
-        (static_cast<int>(match->places.size()) >= kBallSeedPlaces || match->frames >= 2 * kBallSeedFrames);
+        (static_cast<int>(match->places.size()) >= kBallSeedPlaces || match->frames >= 2 * kBallSeedFrames) &&
+        match->log_radial <= max_log_extent && match->log_tangential <= max_log_extent;
     if (enough && ball_lost && !seen) {
       ball.set(match->mean, std::max(params_.sigma_min, match->spread), true);
       stats.ball_seeded = true;

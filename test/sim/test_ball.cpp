@@ -136,6 +136,16 @@ TEST(BallTraining, NoBallFromAMixOfColors) {
   EXPECT_EQ(r.ball.front().frames_with_ball_pixels, 0u);
 }
 
+TEST(BallTraining, NoBallFromABlobWiderThanABall) {
+  // Tuning scene 17 has no ball. A grey-blue shadow across the carpet's edge made blobs of a
+  // ball's size in single frames but 1.8 times as wide on average; it seeded a ball: ball pixels in
+  // 5 of its 53 frames.
+  const sim::SceneResult r =
+      sim::evaluateScene(sim::makeFamilyScene(17), {{"defaults", core::ActParams()}}, sim::EvalOptions());
+  ASSERT_FALSE(r.ball.front().ball_in_scene);
+  EXPECT_EQ(r.ball.front().frames_with_ball_pixels, 0u);
+}
+
 TEST(BallTraining, OffWithOneParameter) {
   core::ActParams params;
   params.ball_training = false;
