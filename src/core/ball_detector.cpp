@@ -25,6 +25,8 @@ constexpr double kGrowSpreads = 3.0;
 constexpr double kGrowMinRadius = 30.0;
 // Blobs looked at per cycle at most (the largest first).
 constexpr size_t kMaxBlobs = 8;
+// A blob whose area or extents exceed a ball's this many times is not a ball alone.
+constexpr double kMaxBallExtent = 2.0;
 
 constexpr uint8_t kNoSector = 255;   // BallDetector::sectors_ of a pixel that does not see the floor
 constexpr uint8_t kGridOff = 0;      // not on the carpet, or not a grid point
@@ -232,7 +234,22 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
     }
     BallBlob blob;
     measure(model, image, lut, safe, known, &blob);
-    if (blob.pixels > 0) blobs->push_back(std::move(blob));
+    if (blob.pixels == 0) continue;
+    // A ball beside a robot's grey part or a shadow unknown to the table makes one component with
+    // it, and its blob, grown through colors near both, is several balls large. Grown again from
+    // the points of the ball's class alone, it is the ball.
+    if (blob.ball_pixels > 0 &&
+        std::max({blob.area_ratio, blob.radial_ratio, blob.tangential_ratio}) > kMaxBallExtent) {
+      const size_t all = seeds_.size();
+      seeds_.erase(std::remove_if(seeds_.begin(), seeds_.end(), [&](uint32_t p) { return tableClass(p) != kOrange; }),
+                   seeds_.end());
+      if (!seeds_.empty() && seeds_.size() < all) {
+        BallBlob ball;
+        measure(model, image, lut, safe, known, &ball);
+        if (ball.pixels > 0) blob = std::move(ball);
+      }
+    }
+    blobs->push_back(std::move(blob));
   }
 }
 
