@@ -235,9 +235,9 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
     BallBlob blob;
     measure(model, image, lut, safe, known, &blob);
     if (blob.pixels == 0) continue;
-    // A ball beside a robot's grey part or a shadow unknown to the table makes one component with
-    // it, and its blob, grown through colors near both, is several balls large. Grown again from
-    // the points of the ball's class alone, it is the ball.
+    // A ball beside a grey region unknown to the table (the floor beyond the carpet's edge, a
+    // shadow) makes one component with it, and its blob, grown through colors near both, is
+    // several balls large. Grown again from the points of the ball's class alone, it is the ball.
     if (blob.ball_pixels > 0 &&
         std::max({blob.area_ratio, blob.radial_ratio, blob.tangential_ratio}) > kMaxBallExtent) {
       const size_t all = seeds_.size();

@@ -147,9 +147,10 @@ TEST(BallTraining, NoBallFromABlobWiderThanABall) {
 }
 
 TEST(BallTraining, BallBesideAGreyThingIsStillTheBall) {
-  // Tuning scene 74: a pink ball rolls beside a grey region the table does not know; grown through
-  // the colors of both, its blob was 2-4 times a ball's size and the ball was not seen again
-  // (recall 0.07 after 30 frames in view); grown from its own class's points, 0.46.
+  // Tuning scene 74: a pink ball at the carpet's edge, beside the grey floor beyond it, which the
+  // table does not know; grown through the colors of both, its blob was 2-4 times a ball's size
+  // and the ball was not seen again (recall 0.07 after 30 frames in view); grown from its own
+  // class's points, 0.46.
   const sim::SceneResult r =
       sim::evaluateScene(sim::makeFamilyScene(74), {{"defaults", core::ActParams()}}, sim::EvalOptions());
   ASSERT_TRUE(r.ball.front().ball_in_scene);
