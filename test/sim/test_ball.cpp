@@ -74,6 +74,12 @@ BallRun run(const core::Calibration& calibration, const sim::RendererOptions& op
 
 const core::Pose2D kPose{-1.0, 0.5, 0.3};
 
+// The ball's figures of a family scene (act_eval's), ACT with the defaults.
+sim::BallFigures ballWithDefaults(uint32_t seed) {
+  return sim::evaluateScene(sim::makeFamilyScene(seed), {{"defaults", core::ActParams()}}, sim::EvalOptions())
+      .ball.front();
+}
+
 TEST(BallGeometry, ExpectedImageMatchesRenderedBall) {
   // The rendered ball's pixel count against BallGeometry's ellipse, from near to far.
   for (const core::Calibration& calibration : {defaultCalibration(), secondCalibration()}) {
@@ -130,20 +136,18 @@ TEST(BallTraining, NoBallFromAMixOfColors) {
   // Tuning scene 92 has no ball. A blob of mixed colors (spread 110) once began a hypothesis
   // whose match radius (2.5 spreads) then took in a pink blob on the carpet, frame after frame,
   // and seeded a ball from both: ball pixels in 28 of its 55 frames.
-  const sim::SceneResult r =
-      sim::evaluateScene(sim::makeFamilyScene(92), {{"defaults", core::ActParams()}}, sim::EvalOptions());
-  ASSERT_FALSE(r.ball.front().ball_in_scene);
-  EXPECT_EQ(r.ball.front().frames_with_ball_pixels, 0u);
+  const sim::BallFigures r = ballWithDefaults(92);
+  ASSERT_FALSE(r.ball_in_scene);
+  EXPECT_EQ(r.frames_with_ball_pixels, 0u);
 }
 
 TEST(BallTraining, NoBallFromABlobWiderThanABall) {
   // Tuning scene 17 has no ball. A grey-blue shadow across the carpet's edge made blobs of a
   // ball's size in single frames but 1.8 times as wide on average; it seeded a ball: ball pixels in
   // 5 of its 53 frames.
-  const sim::SceneResult r =
-      sim::evaluateScene(sim::makeFamilyScene(17), {{"defaults", core::ActParams()}}, sim::EvalOptions());
-  ASSERT_FALSE(r.ball.front().ball_in_scene);
-  EXPECT_EQ(r.ball.front().frames_with_ball_pixels, 0u);
+  const sim::BallFigures r = ballWithDefaults(17);
+  ASSERT_FALSE(r.ball_in_scene);
+  EXPECT_EQ(r.frames_with_ball_pixels, 0u);
 }
 
 TEST(BallTraining, BallBesideAGreyThingIsStillTheBall) {
@@ -151,11 +155,10 @@ TEST(BallTraining, BallBesideAGreyThingIsStillTheBall) {
   // table does not know; grown through the colors of both, its blob was 2-4 times a ball's size
   // and the ball was not seen again (recall 0.07 after 30 frames in view); grown from its own
   // class's points, 0.46.
-  const sim::SceneResult r =
-      sim::evaluateScene(sim::makeFamilyScene(74), {{"defaults", core::ActParams()}}, sim::EvalOptions());
-  ASSERT_TRUE(r.ball.front().ball_in_scene);
-  EXPECT_GE(r.ball.front().recall(), 0.35);
-  EXPECT_GE(r.ball.front().sightings, r.ball.front().frames_in_view / 2);
+  const sim::BallFigures r = ballWithDefaults(74);
+  ASSERT_TRUE(r.ball_in_scene);
+  EXPECT_GE(r.recall(), 0.35);
+  EXPECT_GE(r.sightings, r.frames_in_view / 2);
 }
 
 TEST(BallTraining, OffWithOneParameter) {
