@@ -372,9 +372,12 @@ std::string formatReport(const FamilyReport& r) {
 std::string formatScene(const SceneResult& s) {
   std::string out;
   char line[256];
-  std::snprintf(line, sizeof(line), "seed %u (%zu frames, render %.1f s, ACT %.1f s): %s\n", s.seed, s.frames,
-                s.render_seconds, s.act_seconds, s.summary.c_str());
+  // The summary can be longer than the line buffer (composed light events): appended whole.
+  std::snprintf(line, sizeof(line), "seed %u (%zu frames, render %.1f s, ACT %.1f s): ", s.seed, s.frames,
+                s.render_seconds, s.act_seconds);
   out += line;
+  out += s.summary;
+  out += "\n";
   for (size_t seg = 0; seg < s.ceiling.size(); ++seg) {
     std::snprintf(line, sizeof(line), "  segment '%s' F1", s.segments[0][seg].event.c_str());
     out += line;

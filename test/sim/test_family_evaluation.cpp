@@ -42,5 +42,18 @@ TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
   EXPECT_NE(text.find("F1 below the paper"), std::string::npos);
 }
 
+TEST(FamilyEvaluation, ALongSceneSummaryIsPrintedWholeOnItsOwnLine) {
+  // Composed light events make summaries longer than one print buffer (report seed 1052's was
+  // cut and ran into its first segment's line).
+  sim::SceneResult s;
+  s.seed = 1052;
+  s.summary = std::string(400, 'x') + " events: gain_0.5@19";
+  s.mode_names = {"defaults"};
+  const std::string text = sim::formatScene(s);
+  const size_t at = text.find(s.summary);
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_EQ(text[at + s.summary.size()], '\n');
+}
+
 }  // namespace
 }  // namespace act_color
