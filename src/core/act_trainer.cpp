@@ -46,8 +46,17 @@ constexpr double kLightChangeMinShift = 5.0;
 // color of the ball seen off the field as often as on it gives more false sightings than true.
 constexpr double kBallEvidenceRatio = 1.0;
 
-// A channel at or above this value is clipped (see the removal step).
+// A channel at or above this value is clipped. A saturated line and a saturated window or lamp are
+// the same color: a clipped color is removed on the evidence rule (and kept from being added again)
+// only when it is seen off the field this many times as often as in the field (at least
+// ActParams::evidence_removal_ratio). Without
+// the rule for clipped colors (tuning split) white hall boxes clipped like the lines' cores stayed
+// white (scene 92: white F1 0.61, paper 0.67) and so did a clipped hall color next to a goal
+// brightened 1.5x (scene 78); at the ordinary ratio (3) white F1 fell from 0.19 to 0.01 after a
+// brightening that clips the lines (scene 88) and a real image took 40 cycles after gamma 1.6
+// (nubot_2, 15 at this ratio).
 constexpr uint8_t kClippedValue = 254;
+constexpr double kClippedEvidenceRatio = 10.0;
 
 // Pixels the cluster and addition steps fetch ahead of the one they look at.
 constexpr int kSamplesAhead = 16;
@@ -328,7 +337,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
     const uint8_t current = lut_.at(cell);
     if (current != k && current != kUnknown) e = Evidence{0.f, 0.f, this_cycle};
     e.in_field += static_cast<float>(add_weight_);
-    if (current != k && e.off_field > evidenceRatio(k) * e.in_field) return 0;
+    if (current != k && e.off_field > evidenceRatio(k, c) * e.in_field) return 0;
   }
   // A cell sampled for k before in this cycle has had its neighbourhood filled with this very
   // cluster: doing it again changes nothing.
@@ -502,8 +511,11 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
   boundary_t_ = kBoundaryLow + 0.5 * (first + last) * bin_width;
 }
 
-double ActTrainer::evidenceRatio(uint8_t k) const {
-  return k == kOrange ? std::min(params_.evidence_removal_ratio, kBallEvidenceRatio) : params_.evidence_removal_ratio;
+double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
+  if (k == kOrange) return std::min(params_.evidence_removal_ratio, kBallEvidenceRatio);
+  if (std::max({c[0], c[1], c[2]}) >= kClippedValue)
+    return std::max(params_.evidence_removal_ratio, kClippedEvidenceRatio);
+  return params_.evidence_removal_ratio;
 }
 
 uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
@@ -979,7 +991,7 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
       if (lut_.at(cell) != kOrange) continue;  // removed by an earlier pixel of this cycle
       Evidence& e = evidence(cell);
       e.off_field += weight;
-      if (neighbour_only_[cell] || e.off_field > evidenceRatio(kOrange) * e.in_field) {
+      if (neighbour_only_[cell] || e.off_field > evidenceRatio(kOrange, c) * e.in_field) {
         removeCell(cell);
         confirmed_[cell] = 0;
         ++stats.removed[kOrange];
@@ -1113,17 +1125,14 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
     if (k >= kNumClasses) continue;
     if (!model_.offField(sample.pixel, transform)) continue;
     ++stats.remove_candidates;
-    // A clipped color is no evidence: a saturated line and a saturated window or lamp are the same
-    // color; the paper's rule alone decides about it. The ball is one small object whose colors are
-    // never expected from the pose: its clipped colors are evidence like any other, and one
-    // sighting off the field counts.
+    // The ball is one small object whose colors are never expected from the pose: one sighting off
+    // the field counts.
     const bool ball = k == kOrange;
-    const bool clipped = !ball && std::max({c[0], c[1], c[2]}) >= kClippedValue;
-    if (params_.evidence_removal_ratio > 0 && !clipped) {
+    if (params_.evidence_removal_ratio > 0) {
       Evidence& e = evidence(cell);
       e.off_field += static_cast<float>(params_.remove_stride);
       if (e.off_field >= (ball ? 1 : kMinOffFieldSightings) * params_.remove_stride &&
-          e.off_field > evidenceRatio(k) * e.in_field) {
+          e.off_field > evidenceRatio(k, c) * e.in_field) {
         removeCell(cell);
         confirmed_[cell] = 0;
         ++stats.removed[k];

@@ -595,6 +595,58 @@ TEST_F(ActTrainerTest, ColorsSeenMoreOftenOffTheFieldThanInItAreRemovedWithinXiS
   EXPECT_EQ(patch.first, kGreen);
 }
 
+TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
+  // The lines in the top quarter of the image painted in one color, and the hall beside the field
+  // in the same color on some rows: a saturated line and a saturated lamp are one color. Seen off
+  // the field some eight times as often as in it, an unclipped color is removed (the ratio is 3)
+  // and a clipped one stays (its ratio is 10); seen off the field everywhere (some 60 times as
+  // often), it is removed too.
+  const Pose2D near_corner{7.5, 4.5, 0.0};
+  const auto clean = paintFlatFrame(model, near_corner, 1.0, 1);
+  const PoseTransform t(near_corner);
+  auto line = [&](int v, int u) { return v < 145 && model.geometricClass(v * 580 + u, t) == kWhite; };
+  size_t lines = 0, hall = 0;
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      lines += line(v, u);
+      hall += model.offField(v * 580 + u, t);
+    }
+  }
+  ASSERT_GT(lines, 1000u);
+  const int some_rows = static_cast<int>(hall / (8 * lines));
+  ASSERT_GE(some_rows, 2);
+  auto run = [&](uint8_t value, int every_nth_row) {
+    const cv::Vec3b color(value, value, value);
+    cv::Mat frame = clean.rgb.clone();
+    for (int v = 0; v < 580; ++v) {
+      for (int u = 0; u < 580; ++u) {
+        if (line(v, u)) frame.at<cv::Vec3b>(v, u) = color;
+      }
+    }
+    ActTrainer trainer(cal, ActParams());
+    trainer.bootstrap(view(frame), near_corner, 30);
+    EXPECT_EQ(trainer.lut().classOf(value, value, value), kWhite) << int(value);
+    for (int v = 0; v < 580; v += every_nth_row) {
+      for (int u = 0; u < 580; ++u) {
+        if (model.offField(v * 580 + u, t)) frame.at<cv::Vec3b>(v, u) = color;
+      }
+    }
+    // The in-field counts of the start-up decay (half-life 40 cycles); then the fraction of
+    // cycles in which the color is white (a removed cell comes back when the in-field count
+    // catches up, and goes again).
+    for (int i = 0; i < 100; ++i) trainer.cycle(view(frame), near_corner);
+    int white = 0;
+    for (int i = 0; i < 100; ++i) {
+      trainer.cycle(view(frame), near_corner);
+      white += trainer.lut().classOf(value, value, value) == kWhite;
+    }
+    return white / 100.0;
+  };
+  EXPECT_LT(run(240, some_rows), 0.1);
+  EXPECT_GT(run(255, some_rows), 0.9);
+  EXPECT_LT(run(255, 1), 0.1);
+}
+
 TEST_F(ActTrainerTest, ARobotInFrontOfAGoalAtStartUpDoesNotBecomeTheGoal) {
   // Facing the blue goal from 2 m, with 70% of the goal's pixels showing a robot in the own
   // chassis's color: the goal's first samples are mostly robot. Black (the chassis) is updated

@@ -67,10 +67,10 @@ struct ActParams {
   // show its color in the field as its class (in-field samples x add stride) and off the field
   // (off-field samples x remove_stride). A cell whose off-field count exceeds this many times its
   // in-field count is removed whatever its distance from the cluster: the color is more often
-  // something else than the class (a spot-lit whitish hall floor next to white). Clipped colors
-  // (a channel at 254 or 255) count for nothing: a saturated line and a saturated lamp are one
-  // color (on a real image brightened 1.5x the rule took white's saturated cell and lost 80% of the
-  // line pixels). 0: off.
+  // something else than the class (a spot-lit whitish hall floor next to white). A clipped color
+  // (a channel at 254 or 255) needs ten times the in-field count: a saturated line and a saturated
+  // lamp are one color, and after a brightening that clips the lines' cores the hall's clipped
+  // pixels can outnumber them. 0: off.
   double evidence_removal_ratio = 3.0;
   // Where the carpet meets a line the image shows mixed colors (blur, a line narrower than a
   // pixel), and the field model says which side of the boundary each pixel lies on. Along the axis
@@ -193,8 +193,9 @@ class ActTrainer {
   // ActParams::learned_boundary: counts this cycle's pixels near the carpet-line boundary, learns
   // the split from the counts and removes the white cells that lie wholly on the carpet's side.
   void learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
-  // ActParams::evidence_removal_ratio for class k (lower for the ball).
-  double evidenceRatio(uint8_t k) const;
+  // ActParams::evidence_removal_ratio for color c of class k (lower for the ball, higher for a
+  // clipped color).
+  double evidenceRatio(uint8_t k, const uint8_t c[3]) const;
   // Light compensation: the map moves every cluster and every table cell.
   void applyLightChange(const LightModel::Map& map);
   // Light that comes and goes (flicker, an exposure controller hunting, one dark frame in ten):
