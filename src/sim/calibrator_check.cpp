@@ -96,6 +96,9 @@ CalibratorCheck checkCalibrator(uint32_t seed) {
   check.refusal = calibrator.rejection(fit);
   check.profile = fit.profile;
   check.pose_error_m = std::hypot(fit.pose.x_m - truth.x_m, fit.pose.y_m - truth.y_m);
+  check.residual_median_m = fit.residual.median_m;
+  check.carpet_inlier_fraction = fit.residual.carpet_inlier_fraction;
+  check.carpet_on_lines = fit.carpet_on_lines;
   const core::CameraCalibration& true_camera = scene.calibration.camera;
   std::vector<double> radii;
   for (const cv::Point2f& p : fit.line_pixels) {
@@ -112,7 +115,8 @@ CalibratorCheck checkCalibrator(uint32_t seed) {
 std::string formatCalibratorChecks(const std::vector<CalibratorCheck>& checks) {
   std::ostringstream out;
   out << "| seed | result | profile | distance error from 1 m: median / p95 | whole field: median / p95 | bearing "
-         "p95 (deg) | pose error | fit time | scene |\n|---|---|---|---|---|---|---|---|---|\n";
+         "p95 (deg) | pose error | residual: median, inliers, carpet on lines | fit time | scene "
+         "|\n|---|---|---|---|---|---|---|---|---|---|\n";
   size_t passed = 0, refused = 0, written_wrong = 0;
   char line[640];
   for (const CalibratorCheck& c : checks) {
@@ -121,17 +125,18 @@ std::string formatCalibratorChecks(const std::vector<CalibratorCheck>& checks) {
     refused += refuses;
     written_wrong += !refuses && !c.passed();
     if (!c.fitted) {
-      std::snprintf(line, sizeof(line), "| %u | refused: %s | | | | | | | %s |\n", c.seed, c.refusal.c_str(),
-                    c.summary.c_str());
+      out << "| " << c.seed << " | refused: " << c.refusal << " | | | | | | | | ";
     } else {
       std::snprintf(
-          line, sizeof(line), "| %u | %s | %s | %.2f%% / %.2f%% | %.2f%% / %.2f%% | %.2f | %.3f m | %.1f s | %s |\n",
+          line, sizeof(line),
+          "| %u | %s | %s | %.2f%% / %.2f%% | %.2f%% / %.2f%% | %.2f | %.3f m | %.3f m, %.2f, %.1f%% | %.1f s | ",
           c.seed, c.passed() ? "within the targets" : (refuses ? "refused" : "written, off target"), c.profile.c_str(),
           100 * c.lines.distance_median, 100 * c.lines.distance_p95, 100 * c.whole.distance_median,
           100 * c.whole.distance_p95, std::max(c.lines.bearing_p95_deg, c.whole.bearing_p95_deg), c.pose_error_m,
-          c.seconds, c.summary.c_str());
+          c.residual_median_m, c.carpet_inlier_fraction, 100 * c.carpet_on_lines, c.seconds);
+      out << line;
     }
-    out << line;
+    out << c.summary << " |\n";
   }
   std::snprintf(line, sizeof(line),
                 "\n%zu of %zu cameras within the targets (ground distance 2%%, bearing 1 degree); %zu refused; %zu "

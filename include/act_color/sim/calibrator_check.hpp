@@ -34,6 +34,10 @@ struct CalibratorCheck {
   std::string refusal;  // why the calibrator would refuse it ("" when it would write the file)
   std::string profile;
   double pose_error_m = 0;
+  // What the calibrator itself sees of its fit (the refusal is decided on them): median distance of
+  // the line pixels to the model's lines, the fraction of those on the carpet within 0.08 m, and
+  // the fraction of carpet pixels the model puts on a painted line.
+  double residual_median_m = 0, carpet_inlier_fraction = 0, carpet_on_lines = 0;
   // From 1 m out to the farthest line pixels (98th percentile): where the image constrains the
   // mapping; nearer, a line passing the robot runs almost radially and the profile extrapolates.
   MappingError lines;
