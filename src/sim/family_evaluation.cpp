@@ -394,6 +394,23 @@ std::string formatScene(const SceneResult& s) {
       out += line;
     }
     out += "\n";
+    // Cycles to settle per mode, as the report counts them (after a sudden change of light; the
+    // segment's length when never settled).
+    const core::SegmentSummary& first = s.segments[0][seg];
+    if (first.first_frame == 0 || !startsWithSuddenChange(first.event)) continue;
+    out += "    settle";
+    for (int k : reportedClasses()) {
+      if (s.ceiling[seg].truthCount(k) == 0 || std::isnan(first.final_recall[k])) continue;
+      std::snprintf(line, sizeof(line), "  %s", core::className(k));
+      out += line;
+      for (size_t m = 0; m < s.mode_names.size(); ++m) {
+        const core::SegmentSummary& ss = s.segments[m][seg];
+        std::snprintf(line, sizeof(line), " %d",
+                      ss.settle_cycles[k] < 0 ? static_cast<int>(ss.frames) : ss.settle_cycles[k]);
+        out += line;
+      }
+    }
+    out += "\n";
   }
   for (size_t m = 0; m < s.ball.size(); ++m) {
     const BallFigures& b = s.ball[m];

@@ -29,6 +29,9 @@ TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
       EXPECT_EQ(r.segments[1][s].adapted.truthCount(core::kGreen), r.ceiling[s].truthCount(core::kGreen));
     }
   }
+  // Seed 0 is darkened at frame 16: its scene lines give the cycles each mode took to settle.
+  EXPECT_NE(sim::formatScene(results[0]).find("segment 'darken'"), std::string::npos);
+  EXPECT_NE(sim::formatScene(results[0]).find("    settle  green "), std::string::npos);
   const sim::FamilyReport report = sim::summarize(results);
   ASSERT_EQ(report.recall.size(), 3u);  // defaults, paper, ceiling
   for (int k : {core::kGreen, core::kWhite}) {
