@@ -49,12 +49,11 @@ constexpr double kBallEvidenceRatio = 1.0;
 // A channel at or above this value is clipped. A saturated line and a saturated window or lamp are
 // the same color: a clipped color is removed on the evidence rule (and kept from being added again)
 // only when it is seen off the field this many times as often as in the field (at least
-// ActParams::evidence_removal_ratio). Without
-// the rule for clipped colors (tuning split) white hall boxes clipped like the lines' cores stayed
-// white (scene 92: white F1 0.61, paper 0.67) and so did a clipped hall color next to a goal
-// brightened 1.5x (scene 78); at the ordinary ratio (3) white F1 fell from 0.19 to 0.01 after a
-// brightening that clips the lines (scene 88) and a real image took 40 cycles after gamma 1.6
-// (nubot_2, 15 at this ratio).
+// ActParams::evidence_removal_ratio). Tuning split: while clipped colors were no evidence at all,
+// white hall boxes clipped like the lines' cores stayed white (scene 92: white F1 0.61, the paper's
+// 0.67), and so did a clipped hall color beside a goal brightened 1.5x (scene 78); at the ordinary
+// ratio (3), white F1 fell from 0.20 to 0.01 after a brightening that clips the lines (scene 88)
+// and a real image took 40 cycles to get white back after gamma 1.6 (nubot_2; 15 at this ratio).
 constexpr uint8_t kClippedValue = 254;
 constexpr double kClippedEvidenceRatio = 10.0;
 
