@@ -50,6 +50,13 @@ bool startsWithSuddenChange(const std::string& event) {
   return false;
 }
 
+// Cycles class k took to settle in a segment, as the report counts them: only after a sudden change
+// of light and for a class the segment shows (else -1); the segment's length when never settled.
+int settleCycles(const core::SegmentSummary& ss, int k) {
+  if (ss.first_frame == 0 || !startsWithSuddenChange(ss.event) || std::isnan(ss.final_recall[k])) return -1;
+  return ss.settle_cycles[k] < 0 ? static_cast<int>(ss.frames) : ss.settle_cycles[k];
+}
+
 // The trained classes and the ball.
 const std::vector<int>& reportedClasses() {
   static const std::vector<int> classes = [] {
@@ -242,9 +249,7 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
             if (diff < -0.02) ++r.f1_below_paper[m][k];
             r.f1_worst_vs_paper[m][k] = std::min(r.f1_worst_vs_paper[m][k], diff);
           }
-          if (ss.first_frame > 0 && startsWithSuddenChange(ss.event) && !std::isnan(ss.final_recall[k])) {
-            settle[m][k].push_back(ss.settle_cycles[k] < 0 ? static_cast<double>(ss.frames) : ss.settle_cycles[k]);
-          }
+          if (settleCycles(ss, k) >= 0) settle[m][k].push_back(settleCycles(ss, k));
         }
       }
     }
@@ -394,19 +399,16 @@ std::string formatScene(const SceneResult& s) {
       out += line;
     }
     out += "\n";
-    // Cycles to settle per mode, as the report counts them (after a sudden change of light; the
-    // segment's length when never settled).
+    // Cycles to settle per mode, as the report counts them.
     const core::SegmentSummary& first = s.segments[0][seg];
     if (first.first_frame == 0 || !startsWithSuddenChange(first.event)) continue;
     out += "    settle";
     for (int k : reportedClasses()) {
-      if (s.ceiling[seg].truthCount(k) == 0 || std::isnan(first.final_recall[k])) continue;
+      if (s.ceiling[seg].truthCount(k) == 0 || settleCycles(first, k) < 0) continue;
       std::snprintf(line, sizeof(line), "  %s", core::className(k));
       out += line;
       for (size_t m = 0; m < s.mode_names.size(); ++m) {
-        const core::SegmentSummary& ss = s.segments[m][seg];
-        std::snprintf(line, sizeof(line), " %d",
-                      ss.settle_cycles[k] < 0 ? static_cast<int>(ss.frames) : ss.settle_cycles[k]);
+        std::snprintf(line, sizeof(line), " %d", settleCycles(s.segments[m][seg], k));
         out += line;
       }
     }

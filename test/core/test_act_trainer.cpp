@@ -604,33 +604,25 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   const Pose2D near_corner{7.5, 4.5, 0.0};
   const auto clean = paintFlatFrame(model, near_corner, 1.0, 1);
   const PoseTransform t(near_corner);
-  auto line = [&](int v, int u) { return v < 145 && model.geometricClass(v * 580 + u, t) == kWhite; };
-  size_t lines = 0, hall = 0;
+  cv::Mat lines(580, 580, CV_8U, cv::Scalar(0)), hall(580, 580, CV_8U, cv::Scalar(0));
   for (int v = 0; v < 580; ++v) {
     for (int u = 0; u < 580; ++u) {
-      lines += line(v, u);
-      hall += model.offField(v * 580 + u, t);
+      lines.at<uint8_t>(v, u) = v < 145 && model.geometricClass(v * 580 + u, t) == kWhite;
+      hall.at<uint8_t>(v, u) = model.offField(v * 580 + u, t);
     }
   }
-  ASSERT_GT(lines, 1000u);
-  const int some_rows = static_cast<int>(hall / (8 * lines));
+  const int line_pixels = cv::countNonZero(lines);
+  ASSERT_GT(line_pixels, 1000);
+  const int some_rows = cv::countNonZero(hall) / (8 * line_pixels);
   ASSERT_GE(some_rows, 2);
   auto run = [&](uint8_t value, int every_nth_row) {
-    const cv::Vec3b color(value, value, value);
+    const cv::Scalar color(value, value, value);
     cv::Mat frame = clean.rgb.clone();
-    for (int v = 0; v < 580; ++v) {
-      for (int u = 0; u < 580; ++u) {
-        if (line(v, u)) frame.at<cv::Vec3b>(v, u) = color;
-      }
-    }
+    frame.setTo(color, lines);
     ActTrainer trainer(cal, ActParams());
     trainer.bootstrap(view(frame), near_corner, 30);
     EXPECT_EQ(trainer.lut().classOf(value, value, value), kWhite) << int(value);
-    for (int v = 0; v < 580; v += every_nth_row) {
-      for (int u = 0; u < 580; ++u) {
-        if (model.offField(v * 580 + u, t)) frame.at<cv::Vec3b>(v, u) = color;
-      }
-    }
+    for (int v = 0; v < 580; v += every_nth_row) frame.row(v).setTo(color, hall.row(v));
     // The in-field counts of the start-up decay (half-life 40 cycles); then the fraction of
     // cycles in which the color is white (a removed cell comes back when the in-field count
     // catches up, and goes again).

@@ -30,8 +30,9 @@ TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
     }
   }
   // Seed 0 is darkened at frame 16: its scene lines give the cycles each mode took to settle.
-  EXPECT_NE(sim::formatScene(results[0]).find("segment 'darken'"), std::string::npos);
-  EXPECT_NE(sim::formatScene(results[0]).find("    settle  green "), std::string::npos);
+  const std::string scene = sim::formatScene(results[0]);
+  EXPECT_NE(scene.find("segment 'darken'"), std::string::npos);
+  EXPECT_NE(scene.find("    settle  green "), std::string::npos);
   const sim::FamilyReport report = sim::summarize(results);
   ASSERT_EQ(report.recall.size(), 3u);  // defaults, paper, ceiling
   for (int k : {core::kGreen, core::kWhite}) {
