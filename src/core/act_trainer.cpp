@@ -57,6 +57,14 @@ constexpr double kBallEvidenceRatio = 1.0;
 constexpr uint8_t kClippedValue = 254;
 constexpr double kClippedEvidenceRatio = 10.0;
 
+// The change of light's own cycle and the ones after it, up to this many in all, add every
+// light_change_add_stride-th pixel. At one cycle, white took more than 2 cycles to settle after 51
+// of 72 sudden changes of the tuning split (some 10 line samples a cycle at add_stride: the line
+// colors the moved table missed came back one by one); at three, 38, and black 44 instead of 53.
+// The later cycles add their samples' own cells only: with their neighbourhoods the table of an
+// exposure swinging 1 +- 0.3 grew beyond 1.5x the steady run's in 6 of 36 runs instead of 3.
+constexpr uint64_t kDenseAddCycles = 3;
+
 // Pixels the cluster and addition steps fetch ahead of the one they look at.
 constexpr int kSamplesAhead = 16;
 
@@ -243,6 +251,7 @@ void ActTrainer::reset(ColorSpace space) {
   dark_position_ = -1;
   dark_frozen_ = false;
   light_states_.clear();
+  last_light_change_ = 0;
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
   boundary_line_.fill(0.f);
@@ -285,6 +294,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   dark_position_ = -1;
   dark_frozen_ = false;
   light_states_.clear();
+  last_light_change_ = 0;
   space_known_ = true;
 }
 
@@ -351,7 +361,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   }
   // The ball is small and its colors lie next to the hall's and the goals': its table grows from
   // its own samples only (neighbour-only cells were most of its false pixels).
-  const int n = subordinate ? 0 : params_.add_neighbourhood_cells;
+  const int n = subordinate || !add_neighbourhoods_ ? 0 : params_.add_neighbourhood_cells;
   if (n == 0) return changed;
   // The neighbourhood of a cell confirmed in the last few cycles was filled with a cluster that
   // has hardly moved since (eta = 4): it is filled again only every kNeighbourhoodRefreshCycles.
@@ -882,8 +892,10 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 
   if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
-  const int add_stride =
-      stats.light_change ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
+  if (stats.light_change) last_light_change_ = revision_ + 1;
+  const bool dense = last_light_change_ != 0 && revision_ + 1 - last_light_change_ < kDenseAddCycles;
+  const int add_stride = dense ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
+  add_neighbourhoods_ = !dense || stats.light_change;
   add_weight_ = add_stride;
   prepareNearestMean();
   everyNth(add_stride, [&](const StridedPixels& p) {

@@ -46,8 +46,9 @@ struct ActParams {
   // the table, so that all classes follow at once instead of re-learning from sparse samples.
   // Anchors that do not move as one light would move them are left to the clusters.
   bool light_compensation = true;
-  // In the cycle of such a change of light every n-th pixel is added (instead of add_stride), so
-  // that what the moved table misses is filled at once.
+  // In the cycle of such a change of light and the two after it every n-th pixel is added (instead
+  // of add_stride), so that what the moved table misses is filled at once (ActTrainer's
+  // kDenseAddCycles).
   int light_change_add_stride = 50;
   // A cell confirmed by an in-field sample of its class (within zeta * sigma) in the last n
   // cycles is not removed for being seen off the field: colors seen on both sides (a dark
@@ -284,7 +285,9 @@ class ActTrainer {
   std::vector<LightState> light_states_;  // the most recently left last
   // One bit per table cell: mapped to a class (32 KB for 6 bits per channel).
   std::vector<uint64_t> mapped_;
-  int add_weight_ = 1;  // pixels one in-field sample stands for in this cycle
+  int add_weight_ = 1;              // pixels one in-field sample stands for in this cycle
+  uint64_t last_light_change_ = 0;  // revision_ + 1 of the last change of light; 0: none
+  bool add_neighbourhoods_ = true;  // this cycle's additions fill their cells' neighbourhoods
   // The removal step's samples start, start + remove_stride, ... that can ever be off the field,
   // with their removal range (ExpectedClassModel::removalRange), by sector of bearings and
   // farthest first within a sector: the samples that may be off the field at a pose are a prefix
