@@ -20,13 +20,14 @@
 namespace {
 
 void printUsage(std::ostream& out) {
-  out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007]\n"
+  out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007] [--set NAME=VALUE]\n"
          "  --dir DIR      every folder of DIR that holds the image\n"
          "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
          "                 and CTableBGR.dat (NuBot's hand-made table, compared with ACT's)\n"
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
          "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n"
-         "  --png DIR      each image beside its classes (defaults, the frame before the change) as a PNG\n";
+         "  --png DIR      each image beside its classes (defaults, the frame before the change) as a PNG\n"
+         "  --set NAME=VALUE  an ActParams parameter of the defaults (repeatable; e.g. seed=2)\n";
 }
 
 bool isFile(const std::string& path) {
@@ -39,6 +40,7 @@ bool isFile(const std::string& path) {
 int main(int argc, char** argv) {
   std::vector<std::string> folders;
   std::string dir, png_dir, image_name = "pic_save0.png", preset = "lab6x4";
+  act_color::core::ActParams defaults;
   try {
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
@@ -57,6 +59,12 @@ int main(int argc, char** argv) {
         preset = value();
       } else if (arg == "--png") {
         png_dir = value();
+      } else if (arg == "--set") {
+        const std::string text = value();
+        const size_t eq = text.find('=');
+        if (eq == std::string::npos) throw std::invalid_argument("--set wants NAME=VALUE, not '" + text + "'");
+        defaults.set(text.substr(0, eq), text.substr(eq + 1));
+        defaults.validate();
       } else if (!arg.empty() && arg[0] == '-') {
         throw std::invalid_argument("unknown option " + arg);
       } else {
@@ -83,8 +91,7 @@ int main(int argc, char** argv) {
   }
 
   using act_color::core::ActParams;
-  const std::vector<std::pair<std::string, ActParams>> modes = {{"defaults", ActParams()},
-                                                                {"paper", ActParams::paper()}};
+  const std::vector<std::pair<std::string, ActParams>> modes = {{"defaults", defaults}, {"paper", ActParams::paper()}};
   std::vector<act_color::sim::RealImageResult> results;
   for (const std::string& folder : folders) {
     act_color::sim::RealImage image;
