@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "act_color/core/pixel_lattice.hpp"
+
 namespace act_color {
 namespace core {
 namespace {
@@ -195,6 +197,8 @@ void ActParams::set(const std::string& name, const std::string& value) {
     evidence_removal_ratio = number();
   } else if (name == "learned_boundary") {
     learned_boundary = boolean();
+  } else if (name == "lattice_sampling") {
+    lattice_sampling = boolean();
   } else if (name == "ball_training") {
     ball_training = boolean();
   } else if (name == "ball_diameter_m") {
@@ -212,6 +216,7 @@ void ActParams::switchOffExtensions() {
   nearest_mean = false;
   evidence_removal_ratio = 0;
   learned_boundary = false;
+  lattice_sampling = false;
   ball_training = false;
 }
 
@@ -450,7 +455,8 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
     return t0 + centre.dot(dir) + cell_reach;
   };
   // The start moves on each cycle (not drawn from rng_: the other steps' samples stay as they were).
-  for (StridedPixels p(static_cast<size_t>(revision_ * 7 % kBoundaryStride), kBoundaryStride, width); p.i < pixels;
+  const int stride = samplingStride(kBoundaryStride);
+  for (StridedPixels p(static_cast<size_t>(revision_ * 7 % static_cast<uint64_t>(stride)), stride, width); p.i < pixels;
        p.next()) {
     uint8_t c[3];
     image.color(p.u, p.v, c);
@@ -782,11 +788,13 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     return c;
   };
 
-  // Every stride-th pixel from a random start. The pixels lie far apart in memory: the ray and,
-  // in images without row padding, the color of the pixel kSamplesAhead strides ahead are fetched.
+  // Every n-th pixel from a random start (lattice_sampling: every samplingStride(n)-th). The pixels
+  // lie far apart in memory: the ray and, in images without row padding, the color of the pixel
+  // kSamplesAhead strides ahead are fetched.
   const size_t bytes_per_pixel = bytesPerPixel(image.format);
   const uint8_t* packed_data = image.step == bytes_per_pixel * width ? image.data : nullptr;
-  auto everyNth = [&](int stride, auto&& visit) {
+  auto everyNth = [&](int n, auto&& visit) {
+    const int stride = samplingStride(n);
     const size_t ahead = static_cast<size_t>(kSamplesAhead) * stride;
     for (StridedPixels p(randomStart(stride), stride, width); p.i < pixels; p.next()) {
       if (p.i + ahead < pixels) {
@@ -896,7 +904,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   const bool dense = last_light_change_ != 0 && revision_ + 1 - last_light_change_ < kDenseAddCycles;
   const int add_stride = dense ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
   add_neighbourhoods_ = !dense || stats.light_change;
-  add_weight_ = add_stride;
+  add_weight_ = samplingStride(add_stride);
   prepareNearestMean();
   everyNth(add_stride, [&](const StridedPixels& p) {
     const uint8_t k = expected(p);
@@ -911,7 +919,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   if (params_.ball_training) trainBall(image, transform, stats);
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
-  const size_t start = randomStart(params_.remove_stride);
+  const size_t start = randomStart(samplingStride(params_.remove_stride));
   const RemovalSamples& samples = removalSamples(start);
   // The samples that may be off the field: in each sector of bearings, a prefix of its list.
   candidates_.clear();
@@ -1141,8 +1149,8 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
     const bool ball = k == kOrange;
     if (params_.evidence_removal_ratio > 0) {
       Evidence& e = evidence(cell);
-      e.off_field += static_cast<float>(params_.remove_stride);
-      if (e.off_field >= (ball ? 1 : kMinOffFieldSightings) * params_.remove_stride &&
+      e.off_field += static_cast<float>(removal_samples_stride_);
+      if (e.off_field >= (ball ? 1 : kMinOffFieldSightings) * removal_samples_stride_ &&
           e.off_field > evidenceRatio(k, c) * e.in_field) {
         removeCell(cell);
         confirmed_[cell] = 0;
@@ -1162,10 +1170,18 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
   }
 }
 
+int ActTrainer::samplingStride(int n) {
+  if (!params_.lattice_sampling) return n;
+  auto [it, inserted] = sampling_strides_.try_emplace(n, n);
+  if (inserted) it->second = latticeStride(n, model_.camera().width());
+  return it->second;
+}
+
 const ActTrainer::RemovalSamples& ActTrainer::removalSamples(size_t start) {
-  if (removal_samples_stride_ != params_.remove_stride) {
+  const int stride = samplingStride(params_.remove_stride);
+  if (removal_samples_stride_ != stride) {
     removal_samples_.clear();
-    removal_samples_stride_ = params_.remove_stride;
+    removal_samples_stride_ = stride;
   }
   auto [it, inserted] = removal_samples_.try_emplace(start);
   if (inserted) {
@@ -1174,8 +1190,7 @@ const ActTrainer::RemovalSamples& ActTrainer::removalSamples(size_t start) {
       RemovalSample sample;
     };
     std::vector<Entry> entries;
-    const size_t stride = static_cast<size_t>(params_.remove_stride);
-    for (size_t i = start; i < model_.pixels(); i += stride) {
+    for (size_t i = start; i < model_.pixels(); i += static_cast<size_t>(stride)) {
       const float range = model_.removalRange(i);
       if (range > -std::numeric_limits<float>::infinity()) {  // can be off the field at some pose
         const auto u = static_cast<uint16_t>(i % model_.camera().width());

@@ -234,6 +234,7 @@ bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) 
                     readParam(pnh_, "nearest_mean", &p.nearest_mean, error) &&
                     readParam(pnh_, "evidence_removal_ratio", &p.evidence_removal_ratio, error) &&
                     readParam(pnh_, "learned_boundary", &p.learned_boundary, error) &&
+                    readParam(pnh_, "lattice_sampling", &p.lattice_sampling, error) &&
                     readParam(pnh_, "ball_training", &p.ball_training, error) &&
                     readParam(pnh_, "ball_diameter_m", &p.ball_diameter_m, error);
   if (!read) return false;
@@ -452,6 +453,7 @@ ActTrainerConfig ActTrainerNodelet::configInEffect() const {
   c.nearest_mean = p.nearest_mean;
   c.evidence_removal_ratio = p.evidence_removal_ratio;
   c.learned_boundary = p.learned_boundary;
+  c.lattice_sampling = p.lattice_sampling;
   c.ball_training = p.ball_training;
   c.ball_diameter_m = p.ball_diameter_m;
   c.max_pose_age = max_pose_age_s_;
@@ -480,6 +482,7 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
   p.nearest_mean = c.nearest_mean;
   p.evidence_removal_ratio = c.evidence_removal_ratio;
   p.learned_boundary = c.learned_boundary;
+  p.lattice_sampling = c.lattice_sampling;
   p.ball_training = c.ball_training;
   p.ball_diameter_m = c.ball_diameter_m;
   try {

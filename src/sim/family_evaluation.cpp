@@ -105,6 +105,7 @@ std::vector<EvalMode> evalModes(bool ablations) {
       {"nearest_mean", [](core::ActParams& p) { p.nearest_mean = false; }},
       {"evidence_removal_ratio", [](core::ActParams& p) { p.evidence_removal_ratio = 0; }},
       {"learned_boundary", [](core::ActParams& p) { p.learned_boundary = false; }},
+      {"lattice_sampling", [](core::ActParams& p) { p.lattice_sampling = false; }},
   };
   for (const auto& [name, apply] : off) {
     EvalMode m{"no_" + name, core::ActParams()};

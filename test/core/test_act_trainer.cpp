@@ -5,6 +5,7 @@
 
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/metrics.hpp"
+#include "act_color/core/pixel_lattice.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/sim/flat_painter.hpp"
 #include "test_util.hpp"
@@ -99,12 +100,17 @@ TEST_F(ActTrainerTest, ClusterSamplesEveryNthPixel) {
   EXPECT_EQ(all.cluster_samples[kBlack], counts[kBlack]);
   EXPECT_EQ(all.cluster_samples[kWhite], counts[kWhite]);
   EXPECT_EQ(all.cluster_samples[kUnknown], 0u);  // unknown has no cluster
-  for (int stride : {400, 97}) {
-    p.cluster_stride = stride;
-    ActTrainer trainer(cal, p);
-    const CycleStats s = trainer.cycle(view(frame.rgb), pose);
-    const double expected = static_cast<double>(counts[kGreen]) / stride;
-    EXPECT_NEAR(s.cluster_samples[kGreen], expected, 0.05 * expected + 3) << "stride " << stride;
+  // Every n-th pixel literally (the paper), or every latticeStride(n)-th (lattice_sampling).
+  for (const bool lattice : {false, true}) {
+    for (int stride : {400, 97}) {
+      p.cluster_stride = stride;
+      p.lattice_sampling = lattice;
+      ActTrainer trainer(cal, p);
+      const CycleStats s = trainer.cycle(view(frame.rgb), pose);
+      const int taken = lattice ? latticeStride(stride, cal.camera.width) : stride;
+      const double expected = static_cast<double>(counts[kGreen]) / taken;
+      EXPECT_NEAR(s.cluster_samples[kGreen], expected, 0.05 * expected + 3) << "stride " << stride;
+    }
   }
 }
 
@@ -119,11 +125,14 @@ TEST_F(ActTrainerTest, RemovalExaminesEveryTwentiethOffFieldPixel) {
   ActParams p;
   p.xi = 100.0;
   p.evidence_removal_ratio = 0;  // would remove cells within the cycle, and they would count less
-  ActTrainer trainer(cal, p);
-  trainer.loadTable(all_green);
-  const CycleStats s = trainer.cycle(view(frame.rgb), near_corner);
-  const double expected = counts[kUnknown] / 20.0;
-  EXPECT_NEAR(s.remove_candidates, expected, 0.05 * expected);
+  for (const bool lattice : {false, true}) {
+    p.lattice_sampling = lattice;
+    ActTrainer trainer(cal, p);
+    trainer.loadTable(all_green);
+    const CycleStats s = trainer.cycle(view(frame.rgb), near_corner);
+    const double expected = counts[kUnknown] / static_cast<double>(lattice ? latticeStride(20, cal.camera.width) : 20);
+    EXPECT_NEAR(s.remove_candidates, expected, 0.05 * expected);
+  }
 }
 
 TEST_F(ActTrainerTest, WhiteIsTrainedOnlyFromPixelsBrighterThanTheirNeighbourhood) {

@@ -28,10 +28,12 @@ struct RunResult {
   core::RunEvaluation evaluation;      // per frame and per segment, as act_replay reports them
 };
 
-RunResult runAct(const std::string& name, const core::Calibration& cal = sim_test::defaultCalibration()) {
+RunResult runAct(const std::string& name, const core::Calibration& cal, uint32_t sample_seed) {
   const sim::Renderer renderer(cal);
   const sim::Scenario scenario = sim::makeScenario(name, sim::ScenarioLength::kSmall, cal, 1);
-  core::ActTrainer trainer(cal);
+  core::ActParams params;
+  params.seed = sample_seed;
+  core::ActTrainer trainer(cal, params);
   const core::Segmenter segmenter(cal.camera);
   RunResult result;
   int since_event = 1 << 20;
@@ -70,6 +72,27 @@ RunResult runAct(const std::string& name, const core::Calibration& cal = sim_tes
   return result;
 }
 
+// The trainer's sample seeds (ActParams::seed) each scenario runs with; the tests check the median
+// run. One run's figures move with the seed alone: black's recall under spotlights on the 640x480
+// camera was 0.784-0.83 over seeds 1-12, below 0.80 with 2 of them, and yellow settled after the
+// darkening in 1 cycle with 11 seeds and 13 with one (0.955 from the first frame, 0.975 from frame 22).
+constexpr std::array<uint32_t, 3> kSampleSeeds = {1, 2, 3};
+
+std::vector<RunResult> runActSeeds(const std::string& name,
+                                   const core::Calibration& cal = sim_test::defaultCalibration()) {
+  std::vector<RunResult> runs;
+  for (const uint32_t seed : kSampleSeeds) runs.push_back(runAct(name, cal, seed));
+  return runs;
+}
+
+template <class F>
+double medianOf(const std::vector<RunResult>& runs, F&& value) {
+  std::vector<double> v;
+  for (const RunResult& r : runs) v.push_back(value(r));
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
 // Thresholds per class: recall and precision that must be reached.
 struct Threshold {
   int k;
@@ -77,19 +100,23 @@ struct Threshold {
   double precision;
 };
 
-void expectThresholds(const core::ClassificationMetrics& m, const std::vector<Threshold>& thresholds,
+// On the steady frames, the median over the sample seeds.
+void expectThresholds(const std::vector<RunResult>& runs, const std::vector<Threshold>& thresholds,
                       const std::string& what) {
   for (const Threshold& t : thresholds) {
-    ASSERT_GT(m.truthCount(t.k), 0u) << what << ": no " << core::className(t.k) << " in the truth";
-    EXPECT_GE(m.recall(t.k), t.recall) << what << ": recall of " << core::className(t.k);
-    EXPECT_GE(m.precision(t.k), t.precision) << what << ": precision of " << core::className(t.k);
+    ASSERT_GT(runs.front().steady.truthCount(t.k), 0u) << what << ": no " << core::className(t.k) << " in the truth";
+    EXPECT_GE(medianOf(runs, [&](const RunResult& r) { return r.steady.recall(t.k); }), t.recall)
+        << what << ": recall of " << core::className(t.k);
+    EXPECT_GE(medianOf(runs, [&](const RunResult& r) { return r.steady.precision(t.k); }), t.precision)
+        << what << ": precision of " << core::className(t.k);
   }
 }
 
 // Issue 3's targets: recall >= 0.90 green/white, >= 0.80 yellow/blue/black, precision >= 0.80.
 // ACT does not reach all of them on every simulated scenario (see the measured values in the
-// comments, small scenarios, seed 1, default ActParams); the thresholds below are the measured
-// values with margin, so that a regression of the core or the renderer shows, not the targets.
+// comments, small scenarios, scenario seed 1, sample seed 1, default ActParams); the thresholds
+// below are the measured values with margin, so that a regression of the core or the renderer
+// shows, not the targets.
 struct Case {
   const char* scenario;
   std::vector<Threshold> thresholds;
@@ -99,8 +126,7 @@ class ActOnScenarios : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ActOnScenarios, PerClassAccuracyOutsideAdaptation) {
   const Case& c = GetParam();
-  const RunResult r = runAct(c.scenario);
-  expectThresholds(r.steady, c.thresholds, c.scenario);
+  expectThresholds(runActSeeds(c.scenario), c.thresholds, c.scenario);
 }
 
 INSTANTIATE_TEST_SUITE_P(Small, ActOnScenarios,
@@ -155,8 +181,8 @@ class ActOnSecondCamera : public ::testing::TestWithParam<Case> {};
 
 TEST_P(ActOnSecondCamera, PerClassAccuracyOutsideAdaptation) {
   const Case& c = GetParam();
-  const RunResult r = runAct(c.scenario, sim_test::secondCalibration());
-  expectThresholds(r.steady, c.thresholds, std::string(c.scenario) + " (640x480 camera)");
+  expectThresholds(runActSeeds(c.scenario, sim_test::secondCalibration()), c.thresholds,
+                   std::string(c.scenario) + " (640x480 camera)");
 }
 
 INSTANTIATE_TEST_SUITE_P(Small, ActOnSecondCamera,
@@ -182,21 +208,30 @@ INSTANTIATE_TEST_SUITE_P(Small, ActOnSecondCamera,
 
 // Cycles after a sudden change of light until each class's recall stays within 0.02 of its final
 // recall (the mean over the last quarter of the segment; RunEvaluation, as act_replay prints it).
-// Issue 5 asks for green and white within 2 cycles and every trainable class within 6; issue 3
-// for green and white within 4 frames and all within 12 on the held-out bags.
+// The median over the sample seeds. Issue 5 asks for green and white within 2 cycles and every
+// trainable class within 6; issue 3 for green and white within 4 frames and all within 12 on the
+// held-out bags.
 void expectSettles(const std::string& scenario, const std::string& event,
                    const std::array<int, core::kNumClasses>& max_other_cycles) {
-  const RunResult r = runAct(scenario);
-  const std::vector<core::SegmentSummary> segments = r.evaluation.segments();
-  const auto it =
-      std::find_if(segments.begin(), segments.end(), [&](const core::SegmentSummary& s) { return s.event == event; });
-  ASSERT_NE(it, segments.end()) << scenario << " has no '" << event << "' event";
+  std::vector<core::SegmentSummary> summaries;
+  for (const RunResult& r : runActSeeds(scenario)) {
+    const std::vector<core::SegmentSummary> segments = r.evaluation.segments();
+    const auto it =
+        std::find_if(segments.begin(), segments.end(), [&](const core::SegmentSummary& s) { return s.event == event; });
+    ASSERT_NE(it, segments.end()) << scenario << " has no '" << event << "' event";
+    summaries.push_back(*it);
+  }
   for (int k : core::trainableClasses()) {
-    std::printf("%s: %s settles within 0.02 of its final recall %.3f in %d cycles\n", event.c_str(), core::className(k),
-                it->final_recall[k], it->settle_cycles[k]);
-    EXPECT_GE(it->settle_cycles[k], 1) << core::className(k) << " never settles";
-    EXPECT_LE(it->settle_cycles[k], k == core::kGreen || k == core::kWhite ? 2 : max_other_cycles[k])
-        << core::className(k);
+    std::vector<int> cycles;
+    for (const core::SegmentSummary& s : summaries) {
+      std::printf("%s: %s settles within 0.02 of its final recall %.3f in %d cycles\n", event.c_str(),
+                  core::className(k), s.final_recall[k], s.settle_cycles[k]);
+      cycles.push_back(s.settle_cycles[k]);
+    }
+    std::nth_element(cycles.begin(), cycles.begin() + cycles.size() / 2, cycles.end());
+    const int median = cycles[cycles.size() / 2];
+    EXPECT_GE(median, 1) << core::className(k) << " never settles";
+    EXPECT_LE(median, k == core::kGreen || k == core::kWhite ? 2 : max_other_cycles[k]) << core::className(k);
   }
 }
 

@@ -80,6 +80,11 @@ struct ActParams {
   // the model's pixels change from one to the other (fewest pixels on the wrong side) instead of at
   // the middle between the means; white's cells wholly on the carpet's side are removed when seen.
   bool learned_boundary = true;
+  // "Every n-th pixel" (2.2-2.4) as every s-th, s = latticeStride(n, width) from n to
+  // n + max(3, n / 8), whose samples spread over the whole image (pixel_lattice.hpp): every 400th
+  // pixel of an 800 px wide image lies in two of its columns, and a frame's samples then miss
+  // whatever lies between them.
+  bool lattice_sampling = true;
   // Beyond the paper, which leaves the ball out (2.1): the ball's color is learned from its shape.
   // Compact blobs on the carpet of the image size a sphere of ball_diameter_m has at their
   // distance, surrounded by carpet and of a color no trained class has, are ball candidates; a
@@ -285,6 +290,9 @@ class ActTrainer {
   std::vector<LightState> light_states_;  // the most recently left last
   // One bit per table cell: mapped to a class (32 KB for 6 bits per channel).
   std::vector<uint64_t> mapped_;
+  // The stride "every n-th pixel" takes: latticeStride(n, width) with lattice_sampling, else n.
+  int samplingStride(int n);
+  std::unordered_map<int, int> sampling_strides_;
   int add_weight_ = 1;              // pixels one in-field sample stands for in this cycle
   uint64_t last_light_change_ = 0;  // revision_ + 1 of the last change of light; 0: none
   bool add_neighbourhoods_ = true;  // this cycle's additions fill their cells' neighbourhoods
