@@ -22,6 +22,11 @@ constexpr double kMinRadialFraction = 0.15;
 // ... or lies within this fraction of the ring (plus kChassisTouchPx) outside the chassis.
 constexpr double kChassisRingFraction = 0.03;
 constexpr double kChassisTouchPx = 2.0;
+// Either way its connected part of the image reaches, within kAttachedPx, a pixel where no class is
+// expected (the chassis, the hall, a goal): a strut runs on beyond the field, a cable into the
+// chassis. A ball and its shadow lying on the field make a long radial run too, but carpet is
+// expected all round them.
+constexpr int kAttachedPx = 2;
 // A pixel must have been looked at in this fraction of the frames (at least 1).
 constexpr double kMinLookedFraction = 0.3;
 
@@ -104,6 +109,28 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
         own = run >= min_run;
       }
       if (own) mask.at<uint8_t>(v, u) = 255;
+    }
+  }
+  // Only the parts attached to where no class is expected.
+  cv::Mat unlooked(height, width, CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      if (looked_[static_cast<size_t>(v) * width + u] < min_looked) unlooked.at<uint8_t>(v, u) = 1;
+    }
+  }
+  cv::dilate(unlooked, unlooked,
+             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kAttachedPx + 1, 2 * kAttachedPx + 1)));
+  cv::Mat labels;
+  const int parts = cv::connectedComponents(mask, labels, 8, CV_32S);
+  std::vector<uint8_t> attached(static_cast<size_t>(parts), 0);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      if (unlooked.at<uint8_t>(v, u)) attached[static_cast<size_t>(labels.at<int>(v, u))] = 1;
+    }
+  }
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      if (!attached[static_cast<size_t>(labels.at<int>(v, u))]) mask.at<uint8_t>(v, u) = 0;
     }
   }
   // One pixel more all round: the blurred edges of a strut are neither carpet nor strut.
