@@ -11,6 +11,8 @@ namespace {
 // A stride whose lattice is this near the best in the range is taken: fewer samples cost more than
 // a slightly better spread gains.
 constexpr double kNearBest = 0.95;
+// At most this many strides above n are looked at (bounds the search for huge strides).
+constexpr int kMaxExtra = 64;
 }  // namespace
 
 double latticeSpacing(int stride, int width) {
@@ -31,7 +33,7 @@ double latticeSpacing(int stride, int width) {
 int latticeStride(int n, int width) {
   if (n <= 1) return n;
   // Quality: the spacing over that of a square lattice of the same density (sqrt(s)); 1.07 at best.
-  const int last = n + std::max(3, n / 8);
+  const int last = n + std::clamp(n / 8, 3, kMaxExtra);
   double best_quality = 0;
   for (int s = n; s <= last; ++s) best_quality = std::max(best_quality, latticeSpacing(s, width) / std::sqrt(s));
   for (int s = n; s < last; ++s) {

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <vector>
@@ -43,7 +44,7 @@ TEST(PixelLattice, TheChosenStrideSpreadsItsSamplesOverTheImage) {
     for (int width = 320; width <= 1600; width += 8) {
       const int s = latticeStride(n, width);
       ASSERT_GE(s, n);
-      ASSERT_LE(s, n + std::max(3, n / 8));
+      ASSERT_LE(s, n + std::clamp(n / 8, 3, 64));
       // A square lattice of the same density has spacing sqrt(s); the best possible 1.07 sqrt(s).
       EXPECT_GE(latticeSpacing(s, width), 0.6 * std::sqrt(s)) << "n " << n << " width " << width;
     }
@@ -58,4 +59,8 @@ TEST(PixelLattice, TheChosenStrideSpreadsItsSamplesOverTheImage) {
     EXPECT_EQ(hit.size(), static_cast<size_t>((width / block) * (height / block))) << "start " << start;
   }
   EXPECT_EQ(latticeStride(1, 800), 1);
+  // The largest stride a parameter may take: at most 64 strides above it.
+  const int huge = latticeStride(1 << 20, 1280);
+  EXPECT_GE(huge, 1 << 20);
+  EXPECT_LE(huge, (1 << 20) + 64);
 }

@@ -81,7 +81,7 @@ struct ActParams {
   // the middle between the means; white's cells wholly on the carpet's side are removed when seen.
   bool learned_boundary = true;
   // "Every n-th pixel" (2.2-2.4) as every s-th, s = latticeStride(n, width) from n to
-  // n + max(3, n / 8), whose samples spread over the whole image (pixel_lattice.hpp): every 400th
+  // n + max(3, n / 8) (at most n + 64), whose samples spread over the whole image (pixel_lattice.hpp): every 400th
   // pixel of an 800 px wide image lies in two of its columns, and a frame's samples then miss
   // whatever lies between them.
   bool lattice_sampling = true;
