@@ -366,7 +366,7 @@ uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
   }
   // The ball is small and its colors lie next to the hall's and the goals': its table grows from
   // its own samples only (neighbour-only cells were most of its false pixels).
-  const int n = subordinate || !add_neighbourhoods_ ? 0 : params_.add_neighbourhood_cells;
+  const int n = subordinate || !addsNeighbourhoods() ? 0 : params_.add_neighbourhood_cells;
   if (n == 0) return changed;
   // The neighbourhood of a cell confirmed in the last few cycles was filled with a cluster that
   // has hardly moved since (eta = 4): it is filled again only every kNeighbourhoodRefreshCycles.
@@ -901,9 +901,8 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
   if (stats.light_change) last_light_change_ = revision_ + 1;
-  const bool dense = last_light_change_ != 0 && revision_ + 1 - last_light_change_ < kDenseAddCycles;
-  const int add_stride = dense ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
-  add_neighbourhoods_ = !dense || stats.light_change;
+  const int add_stride =
+      denseAddCycle() ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
   add_weight_ = samplingStride(add_stride);
   prepareNearestMean();
   everyNth(add_stride, [&](const StridedPixels& p) {
@@ -1169,6 +1168,12 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
     }
   }
 }
+
+bool ActTrainer::denseAddCycle() const {
+  return last_light_change_ != 0 && revision_ + 1 - last_light_change_ < kDenseAddCycles;
+}
+
+bool ActTrainer::addsNeighbourhoods() const { return !denseAddCycle() || revision_ + 1 == last_light_change_; }
 
 int ActTrainer::samplingStride(int n) {
   if (!params_.lattice_sampling) return n;

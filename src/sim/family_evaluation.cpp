@@ -250,7 +250,7 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
             if (diff < -0.02) ++r.f1_below_paper[m][k];
             r.f1_worst_vs_paper[m][k] = std::min(r.f1_worst_vs_paper[m][k], diff);
           }
-          if (settleCycles(ss, k) >= 0) settle[m][k].push_back(settleCycles(ss, k));
+          if (const int cycles = settleCycles(ss, k); cycles >= 0) settle[m][k].push_back(cycles);
         }
       }
     }

@@ -295,7 +295,10 @@ class ActTrainer {
   std::unordered_map<int, int> sampling_strides_;
   int add_weight_ = 1;              // pixels one in-field sample stands for in this cycle
   uint64_t last_light_change_ = 0;  // revision_ + 1 of the last change of light; 0: none
-  bool add_neighbourhoods_ = true;  // this cycle's additions fill their cells' neighbourhoods
+  // This cycle adds at light_change_add_stride (a change of light's cycle or one of the two after
+  // it); its additions fill their cells' neighbourhoods unless it is one of the later two.
+  bool denseAddCycle() const;
+  bool addsNeighbourhoods() const;
   // The removal step's samples start, start + remove_stride, ... that can ever be off the field,
   // with their removal range (ExpectedClassModel::removalRange), by sector of bearings and
   // farthest first within a sector: the samples that may be off the field at a pose are a prefix
