@@ -208,6 +208,12 @@ void ActParams::set(const std::string& name, const std::string& value) {
   }
 }
 
+void ActParams::assign(const std::string& assignment) {
+  const size_t eq = assignment.find('=');
+  if (eq == std::string::npos) throw std::invalid_argument("'" + assignment + "' is not NAME=VALUE");
+  set(assignment.substr(0, eq), assignment.substr(eq + 1));
+}
+
 void ActParams::switchOffExtensions() {
   add_neighbourhood_cells = 0;
   light_compensation = false;

@@ -46,7 +46,7 @@ int main(int argc, char** argv) {
   sim::ScenarioLength length = sim::ScenarioLength::kSmall;
   bool ablate = false, per_scene = false;
   sim::EvalOptions options;
-  std::vector<std::pair<std::string, std::string>> overrides;
+  std::vector<std::string> overrides;  // --set name=value
   std::vector<std::string> extra_modes;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -86,10 +86,7 @@ int main(int argc, char** argv) {
       } else if (arg == "--per-scene") {
         per_scene = true;
       } else if (arg == "--set") {
-        const std::string s = value();
-        const size_t eq = s.find('=');
-        if (eq == std::string::npos) return usage("--set wants name=value");
-        overrides.emplace_back(s.substr(0, eq), s.substr(eq + 1));
+        overrides.push_back(value());
       } else if (arg == "--mode") {
         extra_modes.push_back(value());
       } else if (arg == "--png") {
@@ -108,7 +105,7 @@ int main(int argc, char** argv) {
   try {
     for (auto& m : modes) {
       if (m.name == "paper") continue;
-      for (const auto& [name, value] : overrides) m.params.set(name, value);
+      for (const std::string& assignment : overrides) m.params.assign(assignment);
       m.params.validate();
     }
     // --mode NAME:a=1,b=2 : the defaults (with --set) and these parameters.
@@ -119,10 +116,7 @@ int main(int argc, char** argv) {
       std::string rest = colon == std::string::npos ? "" : text.substr(colon + 1);
       while (!rest.empty()) {
         const size_t comma = rest.find(',');
-        const std::string item = rest.substr(0, comma);
-        const size_t eq = item.find('=');
-        if (eq == std::string::npos) throw std::invalid_argument("--mode wants NAME:a=1,b=2, not '" + text + "'");
-        m.params.set(item.substr(0, eq), item.substr(eq + 1));
+        m.params.assign(rest.substr(0, comma));
         rest = comma == std::string::npos ? "" : rest.substr(comma + 1);
       }
       m.params.validate();

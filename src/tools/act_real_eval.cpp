@@ -60,10 +60,7 @@ int main(int argc, char** argv) {
       } else if (arg == "--png") {
         png_dir = value();
       } else if (arg == "--set") {
-        const std::string text = value();
-        const size_t eq = text.find('=');
-        if (eq == std::string::npos) throw std::invalid_argument("--set wants NAME=VALUE, not '" + text + "'");
-        defaults.set(text.substr(0, eq), text.substr(eq + 1));
+        defaults.assign(value());
         defaults.validate();
       } else if (!arg.empty() && arg[0] == '-') {
         throw std::invalid_argument("unknown option " + arg);

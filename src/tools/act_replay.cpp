@@ -99,10 +99,7 @@ int main(int argc, char** argv) {
       } else if (arg == "--evidence-removal-ratio") {
         p.evidence_removal_ratio = number();
       } else if (arg == "--set") {
-        const std::string item = value();
-        const size_t eq = item.find('=');
-        if (eq == std::string::npos) throw std::invalid_argument("--set wants NAME=VALUE");
-        p.set(item.substr(0, eq), item.substr(eq + 1));
+        p.assign(value());
       } else if (arg == "--no-nearest-mean") {
         p.nearest_mean = false;
       } else if (arg == "--bootstrap-cycles") {

@@ -69,6 +69,12 @@ TEST_F(ActTrainerTest, ParametersAreValidatedByName) {
   ActTrainer trainer(cal);
   EXPECT_THROW(trainer.setParams(p), std::invalid_argument);
   EXPECT_DOUBLE_EQ(trainer.params().eta, 4.0);  // unchanged
+  // The tools' --set name=value.
+  p = ActParams();
+  p.assign("lattice_sampling=false");
+  EXPECT_FALSE(p.lattice_sampling);
+  EXPECT_THROW(p.assign("lattice_sampling"), std::invalid_argument);
+  EXPECT_THROW(p.assign("no_such_parameter=1"), std::invalid_argument);
 }
 
 TEST_F(ActTrainerTest, BadInputIsRefusedWithAReason) {

@@ -80,10 +80,9 @@ struct ActParams {
   // the model's pixels change from one to the other (fewest pixels on the wrong side) instead of at
   // the middle between the means; white's cells wholly on the carpet's side are removed when seen.
   bool learned_boundary = true;
-  // "Every n-th pixel" (2.2-2.4) as every s-th, s = latticeStride(n, width) from n to
-  // n + max(3, n / 8) (at most n + 64), whose samples spread over the whole image (pixel_lattice.hpp): every 400th
-  // pixel of an 800 px wide image lies in two of its columns, and a frame's samples then miss
-  // whatever lies between them.
+  // "Every n-th pixel" (2.2-2.4) as every s-th, s = latticeStride(n, width) a little above n,
+  // whose samples spread over the whole image (pixel_lattice.hpp): every 400th pixel of an 800 px
+  // wide image lies in two of its columns, and a frame's samples then miss whatever lies between.
   bool lattice_sampling = true;
   // Beyond the paper, which leaves the ball out (2.1): the ball's color is learned from its shape.
   // Compact blobs on the carpet of the image size a sphere of ball_diameter_m has at their
@@ -99,6 +98,8 @@ struct ActParams {
   // Sets the parameter `name` (as the field is named) from text; throws std::invalid_argument for
   // an unknown name or a value that does not parse. validate() checks the range.
   void set(const std::string& name, const std::string& value);
+  // set() from "name=value" (the tools' --set); throws std::invalid_argument without the '='.
+  void assign(const std::string& assignment);
   // Every extension off: the paper's algorithm exactly.
   void switchOffExtensions();
   static ActParams paper();

@@ -12,9 +12,9 @@ namespace core {
 // their densest direction (about 1.07 sqrt(s) for the best lattices, 1 for columns).
 double latticeSpacing(int stride, int width);
 
-// The smallest stride from n to n + max(3, n / 8) (at most n + 64) whose lattice is spread nearly as well as the best
-// in that range (spacing over sqrt(stride)): about as many samples as every n-th pixel, over the
-// whole image.
+// The smallest stride from n to n + max(3, n / 8) (at most n + 64) whose lattice is spread nearly
+// as well as the best in that range (spacing over sqrt(stride)): about as many samples as every
+// n-th pixel, over the whole image.
 int latticeStride(int n, int width);
 
 }  // namespace core
