@@ -362,5 +362,30 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
   return out.str();
 }
 
+std::string formatRealImageFrames(const std::vector<RealImageResult>& results) {
+  std::ostringstream out;
+  auto series = [&](const char* what, const std::vector<RealFrameFigures>& frames, double RealFrameFigures::*field) {
+    out << "  " << what << ":";
+    for (const RealFrameFigures& f : frames) {
+      if (f.*field < 0) {
+        out << " -";
+      } else {
+        out << " " << static_cast<int>(std::lround(100.0 * (f.*field)));
+      }
+    }
+    out << "\n";
+  };
+  for (const RealImageResult& r : results) {
+    for (const RealVariantResult& row : r.rows) {
+      out << r.name << " " << row.variant << " " << row.mode << " (change from frame " << kRealFramesBefore + 1
+          << ")\n";
+      series("white", row.frames, &RealFrameFigures::white_recall);
+      series("green", row.frames, &RealFrameFigures::green_recall);
+      series("hall ", row.frames, &RealFrameFigures::hall_in_field);
+    }
+  }
+  return out.str();
+}
+
 }  // namespace sim
 }  // namespace act_color

@@ -21,13 +21,16 @@ namespace {
 
 void printUsage(std::ostream& out) {
   out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007] [--set NAME=VALUE]\n"
+         "                    [--png DIR] [--frames]\n"
          "  --dir DIR      every folder of DIR that holds the image\n"
          "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
          "                 and CTableBGR.dat (NuBot's hand-made table, compared with ACT's)\n"
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
          "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n"
          "  --png DIR      each image beside its classes (defaults, the frame before the change) as a PNG\n"
-         "  --set NAME=VALUE  an ActParams parameter of the defaults (repeatable; e.g. seed=2)\n";
+         "  --set NAME=VALUE  an ActParams parameter of the defaults (repeatable; e.g. seed=2)\n"
+         "  --frames       also every frame's white recall, green recall and hall in a field class (after\n"
+         "                 the change from frame 21), per variant and mode\n";
 }
 
 bool isFile(const std::string& path) {
@@ -40,6 +43,7 @@ bool isFile(const std::string& path) {
 int main(int argc, char** argv) {
   std::vector<std::string> folders;
   std::string dir, png_dir, image_name = "pic_save0.png", preset = "lab6x4";
+  bool frames = false;
   act_color::core::ActParams defaults;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -59,6 +63,8 @@ int main(int argc, char** argv) {
         preset = value();
       } else if (arg == "--png") {
         png_dir = value();
+      } else if (arg == "--frames") {
+        frames = true;
       } else if (arg == "--set") {
         defaults.assign(value());
         defaults.validate();
@@ -133,5 +139,6 @@ int main(int argc, char** argv) {
     std::cerr << "act_real_eval: " << image.name << " done\n";
   }
   std::cout << act_color::sim::formatRealImageReport(results);
+  if (frames) std::cout << act_color::sim::formatRealImageFrames(results);
   return 0;
 }

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 #include <string>
 
 #include "act_color/sim/real_image_suite.hpp"
@@ -43,7 +44,29 @@ void expectHolds(const sim::RealImageResult& r) {
   }
 }
 
-TEST(RealImages, Nubot1) { expectHolds(run("nubot_1")); }
+TEST(RealImages, Nubot1) {
+  const sim::RealImageResult r = run("nubot_1");
+  expectHolds(r);
+  // act_real_eval --frames: per variant a title and a line of every frame's figure per measure.
+  std::istringstream frames(sim::formatRealImageFrames({r}));
+  std::string line;
+  int series = 0;
+  while (std::getline(frames, line)) {
+    if (line.rfind("  ", 0) != 0) continue;
+    ++series;
+    std::istringstream values(line.substr(line.find(':') + 1));
+    std::string value;
+    int count = 0;
+    while (values >> value) {
+      ++count;
+      if (line.find("white") != std::string::npos) {
+        EXPECT_NE(value, "-") << line;
+      }
+    }
+    EXPECT_EQ(count, sim::kRealFramesBefore + sim::kRealFramesAfter) << line;
+  }
+  EXPECT_EQ(series, 3 * static_cast<int>(r.rows.size()));
+}
 
 TEST(RealImages, Nubot1BakBak) {
   const sim::RealImageResult r = run("nubot_1_bak_bak");

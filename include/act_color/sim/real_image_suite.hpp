@@ -95,6 +95,9 @@ RealImageResult evaluateRealImage(const RealImage& image,
 
 // A markdown table per image, and the checks.
 std::string formatRealImageReport(const std::vector<RealImageResult>& results);
+// Every frame's figures: per image, variant and mode a line each of white recall, green recall and
+// hall in a field class, in percent ("-" where not measured).
+std::string formatRealImageFrames(const std::vector<RealImageResult>& results);
 
 // Reads a NuBot table (64^3 bytes); an empty vector when the file is missing or not that size.
 std::vector<uint8_t> readNubotTable(const std::string& path);
