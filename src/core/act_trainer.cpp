@@ -1167,6 +1167,12 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
         revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
       continue;
     }
+    // Nor is a color the field shows as k at least kEvidenceKeepRatio times as often as the hall,
+    // however far from the cluster: the evidence decides where it is clear, the distance elsewhere.
+    if (params_.evidence_removal_ratio > 0 && !neighbour_only_[cell] &&
+        evidence_[cell].in_field >= kEvidenceKeepRatio * evidence_[cell].off_field) {
+      continue;
+    }
     if (neighbour_only_[cell] ||
         (remove_mean[k] - Eigen::Vector3f(c[0], c[1], c[2])).squaredNorm() > remove_radius_sq[k]) {
       removeCell(cell);
