@@ -1167,8 +1167,8 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
         revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
       continue;
     }
-    // Nor is a color the field shows as k at least kEvidenceKeepRatio times as often as the hall,
-    // however far from the cluster: the evidence decides where it is clear, the distance elsewhere.
+    // Kept too: a color the field shows as k at least kEvidenceKeepRatio times as often as the hall,
+    // however far from the cluster (the evidence decides where it is clear, 2.4's distance elsewhere).
     if (params_.evidence_removal_ratio > 0 && !neighbour_only_[cell] &&
         evidence_[cell].in_field >= kEvidenceKeepRatio * evidence_[cell].off_field) {
       continue;
