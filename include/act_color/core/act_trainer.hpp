@@ -227,9 +227,10 @@ class ActTrainer {
   static constexpr size_t kEvidenceMemory = 256;           // cycles after which counts are 0
   static constexpr int kMinOffFieldSightings = 3;
   // 2.4's removal beyond xi sigma spares a color whose in-field count is at least this many times
-  // its off-field count. Tuning split, sample seeds 1 and 2: at 2, F1 up by 0.02 or more in 11 and
-  // 9 segments (black, yellow after a wrong pose, the ball), down in 2 and 4; at 1, black up in
-  // some 20 segments but the flicker runs' blue precision 0.01-0.04 lower; at 3, hardly a change.
+  // its off-field count. Tuning split, sample seeds 1, 2 and 3: at 2, F1 up by 0.02 or more in 11,
+  // 9 and 11 segments (black, yellow after a wrong pose, the ball), down in 2, 4 and 0; at 1 (seeds
+  // 1 and 2), black up in some 20 segments but the flicker runs' blue precision 0.01-0.04 lower;
+  // at 3, hardly a change.
   static constexpr float kEvidenceKeepRatio = 2.f;
   // The cell's counts, decayed to this cycle.
   Evidence& evidence(uint32_t cell);
