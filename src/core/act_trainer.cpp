@@ -699,10 +699,15 @@ bool ActTrainer::restoreLightState() {
   return true;
 }
 
+size_t ActTrainer::maxLightStates() const {
+  const size_t state_bytes = lut_.size() * (2 * sizeof(uint8_t) + sizeof(Evidence) + sizeof(uint32_t));
+  return std::clamp<size_t>(kLightStatesBytes / state_bytes, 2, kMaxLightStates);
+}
+
 void ActTrainer::keepLightState() {
   // The oldest state's buffers are reused when the memory is full: no allocation then.
   LightState s;
-  if (light_states_.size() >= kMaxLightStates) {
+  while (light_states_.size() >= maxLightStates()) {
     s = std::move(light_states_.front());
     light_states_.erase(light_states_.begin());
   }
