@@ -1167,15 +1167,13 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
         ++stats.removed[k];
         continue;
       }
+      // And kept: a color the field shows as k at least kEvidenceKeepRatio times as often as the
+      // hall, however far from the cluster (the evidence decides where it is clear, 2.4's distance
+      // elsewhere).
+      if (!neighbour_only_[cell] && e.in_field >= kEvidenceKeepRatio * e.off_field) continue;
     }
     if (confirmed_[cell] != 0 &&
         revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
-      continue;
-    }
-    // Kept too: a color the field shows as k at least kEvidenceKeepRatio times as often as the hall,
-    // however far from the cluster (the evidence decides where it is clear, 2.4's distance elsewhere).
-    if (params_.evidence_removal_ratio > 0 && !neighbour_only_[cell] &&
-        evidence_[cell].in_field >= kEvidenceKeepRatio * evidence_[cell].off_field) {
       continue;
     }
     if (neighbour_only_[cell] ||

@@ -111,13 +111,10 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
       if (own) mask.at<uint8_t>(v, u) = 255;
     }
   }
-  // Only the parts attached to where no class is expected.
-  cv::Mat unlooked(height, width, CV_8UC1, cv::Scalar(0));
-  for (int v = 0; v < height; ++v) {
-    for (int u = 0; u < width; ++u) {
-      if (looked_[static_cast<size_t>(v) * width + u] < min_looked) unlooked.at<uint8_t>(v, u) = 1;
-    }
-  }
+  // Only the parts attached to where no class is expected (looked at in fewer frames than
+  // min_looked; the counts are whole numbers).
+  const cv::Mat looked(height, width, CV_16UC1, const_cast<uint16_t*>(looked_.data()));
+  cv::Mat unlooked = looked < std::ceil(min_looked);
   cv::dilate(unlooked, unlooked,
              cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kAttachedPx + 1, 2 * kAttachedPx + 1)));
   cv::Mat labels;
