@@ -61,5 +61,56 @@ ClassificationMetrics TableCeiling::metrics() const {
   return m;
 }
 
+FalsePixelSources::FalsePixelSources(int bits_per_channel, ColorSpace space) : index_(bits_per_channel, space) {
+  classified_.assign(index_.size(), {});
+  right_.assign(index_.size(), {});
+}
+
+void FalsePixelSources::clear() {
+  std::fill(classified_.begin(), classified_.end(), std::array<uint32_t, kNumClasses>{});
+  std::fill(right_.begin(), right_.end(), std::array<uint32_t, kNumClasses>{});
+}
+
+void FalsePixelSources::add(const ImageView& image, const cv::Mat& labels, const cv::Mat& truth) {
+  if (truth.type() != CV_8UC1 || truth.cols != image.width || truth.rows != image.height || labels.type() != CV_8UC1 ||
+      labels.size() != truth.size()) {
+    throw std::invalid_argument("labels and truth must be mono8 images of the image's size");
+  }
+  if (nativeColorSpace(image.format) != index_.colorSpace()) {
+    throw std::invalid_argument("image is not in the table's color space");
+  }
+  for (int v = 0; v < image.height; ++v) {
+    const uint8_t* t = truth.ptr<uint8_t>(v);
+    const uint8_t* l = labels.ptr<uint8_t>(v);
+    for (int u = 0; u < image.width; ++u) {
+      if (t[u] >= kNumClasses || l[u] >= kNumClasses) continue;
+      uint8_t c[3];
+      image.color(u, v, c);
+      const uint32_t cell = index_.index(c[0], c[1], c[2]);
+      ++classified_[cell][l[u]];
+      right_[cell][l[u]] += l[u] == t[u];
+    }
+  }
+}
+
+std::array<FalsePixels, kNumClasses> FalsePixelSources::sources(const ColorLut& majority) const {
+  if (majority.size() != index_.size()) throw std::invalid_argument("the majority table has another size");
+  std::array<FalsePixels, kNumClasses> out{};
+  const int bits = index_.bitsPerChannel();
+  const uint32_t top = (1u << bits) - 1;
+  for (uint32_t cell = 0; cell < classified_.size(); ++cell) {
+    const uint8_t m = majority.at(cell);
+    const bool at_top = (cell >> (2 * bits)) == top || ((cell >> bits) & top) == top || (cell & top) == top;
+    for (int k = 0; k < kNumClasses; ++k) {
+      const uint64_t n = classified_[cell][k], wrong = n - right_[cell][k];
+      out[k].classified += n;
+      if (wrong == 0) continue;
+      (m == k ? out[k].shared : m == kUnknown ? out[k].hall : out[k].other) += wrong;
+      if (at_top) out[k].top += wrong;
+    }
+  }
+  return out;
+}
+
 }  // namespace core
 }  // namespace act_color

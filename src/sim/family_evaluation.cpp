@@ -130,6 +130,20 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
     evaluations.emplace_back(options.adapt_frames);
   }
   core::TableCeiling ceiling;
+  std::vector<core::FalsePixelSources> false_pixels(options.false_pixels ? modes.size() : 0);
+  result.false_pixels.resize(false_pixels.size());
+  // The ceiling and the false pixels of the segment that ends.
+  auto closeSegment = [&]() {
+    result.ceiling.push_back(ceiling.metrics());
+    if (!false_pixels.empty()) {
+      const core::ColorLut majority = ceiling.table();
+      for (size_t m = 0; m < modes.size(); ++m) {
+        result.false_pixels[m].push_back(false_pixels[m].sources(majority));
+        false_pixels[m].clear();
+      }
+    }
+    ceiling.clear();
+  };
   size_t segment_start = 0;
   result.ball.assign(modes.size(), BallFigures{});
   size_t ball_first_in_view = SIZE_MAX;
@@ -137,8 +151,7 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
   for (size_t i = 0; i < frames.size(); ++i) {
     const ScenarioFrame& f = frames[i];
     if (!f.events.empty() && i > 0) {
-      result.ceiling.push_back(ceiling.metrics());
-      ceiling.clear();
+      closeSegment();
       segment_start = i;
     }
     const auto t0 = Clock::now();
@@ -182,7 +195,10 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
       b.position_ok += error <= 0.15 + 0.05 * std::hypot(bx, by);
     }
     const auto t2 = Clock::now();
-    if (i - segment_start >= options.adapt_frames) ceiling.add(view, frame.labels);
+    if (i - segment_start >= options.adapt_frames) {
+      ceiling.add(view, frame.labels);
+      for (size_t m = 0; m < false_pixels.size(); ++m) false_pixels[m].add(view, labels[m], frame.labels);
+    }
     result.render_seconds += seconds(t1 - t0);
     result.act_seconds += seconds(t2 - t1);
     const bool segment_ends = i + 1 == frames.size() || !frames[i + 1].events.empty();
@@ -192,7 +208,7 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
       writePanel(options.png_dir + name, frame.rgb, labels, frame.labels);
     }
   }
-  result.ceiling.push_back(ceiling.metrics());
+  closeSegment();
   result.frames = frames.size();
   result.adapt_frames = options.adapt_frames;
   for (const core::RunEvaluation& e : evaluations) result.segments.push_back(e.segments());
@@ -207,7 +223,7 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
   const size_t with_ceiling = modes + 1;
   using Values = std::array<std::vector<double>, core::kNumClasses>;
   std::vector<Values> recall(with_ceiling), precision(with_ceiling), recall_gap(modes), precision_gap(modes),
-      settle(modes);
+      settle(modes), false_shared(modes), false_hall(modes), false_other(modes), false_top(modes);
   r.f1_below_paper.assign(modes, {});
   r.f1_worst_vs_paper.assign(modes, {});
   r.worst_recall_seed.assign(modes, {});
@@ -251,6 +267,14 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
             r.f1_worst_vs_paper[m][k] = std::min(r.f1_worst_vs_paper[m][k], diff);
           }
           if (const int cycles = settleCycles(ss, k); cycles >= 0) settle[m][k].push_back(cycles);
+          if (m < s.false_pixels.size() && seg < s.false_pixels[m].size()) {
+            const core::FalsePixels& fp = s.false_pixels[m][seg][k];
+            const double n = std::max<double>(1.0, static_cast<double>(fp.classified));
+            false_shared[m][k].push_back(fp.shared / n);
+            false_hall[m][k].push_back(fp.hall / n);
+            false_other[m][k].push_back(fp.other / n);
+            false_top[m][k].push_back(fp.top / n);
+          }
         }
       }
     }
@@ -297,6 +321,12 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
   r.recall_gap = fill(recall_gap, false);
   r.precision_gap = fill(precision_gap, false);
   r.settle = fill(settle, false);
+  if (!results.front().false_pixels.empty()) {
+    r.false_shared = fill(false_shared, false);
+    r.false_hall = fill(false_hall, false);
+    r.false_other = fill(false_other, false);
+    r.false_top = fill(false_top, false);
+  }
   return r;
 }
 
@@ -336,6 +366,13 @@ std::string formatReport(const FamilyReport& r) {
   table("precision gap to the ceiling", r.precision_gap, false, "median p90 worst; ceiling - mode");
   table("cycles to settle after a sudden change of light", r.settle, false,
         "median p90 worst; within 0.02 of the final recall; never settled = segment length");
+  if (!r.false_shared.empty()) {
+    const char* columns = "median p90 worst; share of the pixels classified as the class";
+    table("false pixels in cells the ceiling gives the class too", r.false_shared, false, columns);
+    table("false pixels in cells of the hall (the ceiling's unknown)", r.false_hall, false, columns);
+    table("false pixels in cells of another class", r.false_other, false, columns);
+    table("false pixels in a cell at the top of a channel (clipped)", r.false_top, false, columns);
+  }
   out += "F1 below the paper's F1 - 0.02 (units; worst F1 difference)\n";
   for (size_t m = 0; m < modes; ++m) {
     std::snprintf(line, sizeof(line), "  %-26s", r.mode_names[m].c_str());

@@ -3,7 +3,7 @@
 // paper's algorithm side by side, the fixed-table ceiling of every scene segment, the gaps to it,
 // the cycles to settle after each event, and where the defaults fall below the paper.
 //   act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full] [--ablate]
-//            [--per-scene] [--png DIR]
+//            [--per-scene] [--png DIR] [--false-pixels]
 // Tune on the tuning split (seeds 0-99); the report split (1000-1099) is for reporting only.
 #include <chrono>
 #include <cstdio>
@@ -23,6 +23,7 @@ namespace sim = act_color::sim;
 const char* const kUsage =
     "usage: act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full]\n"
     "                [--ablate] [--set NAME=VALUE] [--mode NAME:N=V,...] [--per-scene] [--png DIR]\n"
+    "                [--false-pixels]\n"
     "  --split S     report: seeds 1000-1099 (default); tuning: seeds 0-99\n"
     "  --seeds A-B   any range of seeds instead (inclusive)\n"
     "  --count N     only the first N seeds of the range (a quick subset)\n"
@@ -31,7 +32,9 @@ const char* const kUsage =
     "  --set N=V     an ACT parameter for every mode but the paper's (repeatable), e.g. zeta=3\n"
     "  --mode M:N=V,N=V  one more mode: the defaults with these parameters (repeatable)\n"
     "  --per-scene   one line per scene and segment: F1 per class and mode, [ceiling]\n"
-    "  --png DIR     input | labels of each mode | truth, for the last frame of every segment\n";
+    "  --png DIR     input | labels of each mode | truth, for the last frame of every segment\n"
+    "  --false-pixels  also where each class's false pixels lie: in cells the ceiling gives the class\n"
+    "                too, in the hall's cells, in other classes' cells; clipped (slower)\n";
 
 int usage(const std::string& message) {
   std::cerr << "act_eval: " << message << "\n" << kUsage;
@@ -91,6 +94,8 @@ int main(int argc, char** argv) {
         extra_modes.push_back(value());
       } else if (arg == "--png") {
         options.png_dir = value();
+      } else if (arg == "--false-pixels") {
+        options.false_pixels = true;
       } else {
         return usage("unknown option " + arg);
       }

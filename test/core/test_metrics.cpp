@@ -72,3 +72,40 @@ TEST(TableCeiling, MajorityOfTheTruthPerColorCell) {
   EXPECT_THROW(ceiling.add(ImageView::fromMat(rgb, PixelFormat::kRgb8), cv::Mat::zeros(2, 8, CV_8UC1)),
                std::invalid_argument);
 }
+
+TEST(FalsePixelSources, TakesAClassifiersFalsePixelsApartByTheCeilingsCells) {
+  // Four colors, every pixel classified white but one carpet pixel:
+  //   w: truth white, white, hall      -> 1 false white in a white cell (the ceiling's too)
+  //   h: truth hall, hall, white       -> 2 false whites in a hall cell
+  //   g: truth green, green            -> 1 false white in a green cell (the other pixel is green)
+  //   t: truth hall, clipped red       -> 1 false white in a hall cell at the top of a channel
+  const cv::Vec3b w(230, 230, 230), h(200, 190, 180), g(40, 140, 50), t(255, 250, 240), n(0, 0, 0);
+  const std::vector<cv::Vec3b> colors = {w, w, w, h, h, h, g, g, t, n};
+  cv::Mat rgb(1, static_cast<int>(colors.size()), CV_8UC3);
+  for (size_t u = 0; u < colors.size(); ++u) rgb.at<cv::Vec3b>(0, static_cast<int>(u)) = colors[u];
+  const cv::Mat truth = (cv::Mat_<uint8_t>(1, 10) << 2, 2, 0, 0, 0, 2, 1, 1, 0, 255);
+  const cv::Mat labels = (cv::Mat_<uint8_t>(1, 10) << 2, 2, 2, 2, 2, 2, 2, 1, 2, 2);
+  const ImageView view = ImageView::fromMat(rgb, PixelFormat::kRgb8);
+  TableCeiling ceiling;
+  ceiling.add(view, truth);
+  FalsePixelSources sources;
+  sources.add(view, labels, truth);
+  const auto fp = sources.sources(ceiling.table());
+  EXPECT_EQ(fp[kWhite].classified, 8u);  // the pixel outside the mirror is skipped
+  EXPECT_EQ(fp[kWhite].shared, 1u);
+  EXPECT_EQ(fp[kWhite].hall, 3u);
+  EXPECT_EQ(fp[kWhite].other, 1u);
+  EXPECT_EQ(fp[kWhite].top, 1u);
+  // The parts add up to 1 - precision.
+  ClassificationMetrics m;
+  m.add(labels, truth);
+  const double false_share =
+      static_cast<double>(fp[kWhite].shared + fp[kWhite].hall + fp[kWhite].other) / fp[kWhite].classified;
+  EXPECT_DOUBLE_EQ(false_share, 1.0 - m.precision(kWhite));
+  EXPECT_EQ(fp[kGreen].classified, 1u);
+  EXPECT_EQ(fp[kGreen].shared + fp[kGreen].hall + fp[kGreen].other, 0u);
+  sources.clear();
+  EXPECT_EQ(sources.sources(ceiling.table())[kWhite].classified, 0u);
+  EXPECT_THROW(sources.add(view, labels, cv::Mat::zeros(2, 10, CV_8UC1)), std::invalid_argument);
+  EXPECT_THROW(sources.add(view, cv::Mat::zeros(1, 9, CV_8UC1), truth), std::invalid_argument);
+}

@@ -16,17 +16,30 @@ TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
   EXPECT_EQ(modes[0].name, "defaults");
   EXPECT_EQ(modes[1].name, "paper");
   std::vector<sim::SceneResult> results;
+  sim::EvalOptions options;
+  options.false_pixels = true;
   for (uint32_t seed : {sim::kTuningSeedsBegin, sim::kTuningSeedsBegin + 1}) {
-    results.push_back(sim::evaluateScene(sim::makeFamilyScene(seed), modes, sim::EvalOptions()));
+    results.push_back(sim::evaluateScene(sim::makeFamilyScene(seed), modes, options));
     const sim::SceneResult& r = results.back();
     ASSERT_EQ(r.segments.size(), 2u);
     ASSERT_EQ(r.segments[0].size(), r.ceiling.size());  // one ceiling per segment
     ASSERT_EQ(r.segments[1].size(), r.ceiling.size());
+    ASSERT_EQ(r.false_pixels.size(), 2u);
     EXPECT_GE(r.ceiling.size(), 2u);  // every family scene has an event
     for (size_t s = 0; s < r.ceiling.size(); ++s) {
       // Both modes and the ceiling count the same truth pixels after adaptation.
       EXPECT_EQ(r.segments[0][s].adapted.truthCount(core::kGreen), r.ceiling[s].truthCount(core::kGreen));
       EXPECT_EQ(r.segments[1][s].adapted.truthCount(core::kGreen), r.ceiling[s].truthCount(core::kGreen));
+      // The false pixels are taken apart over the same frames: their parts are 1 - precision.
+      for (size_t m = 0; m < 2; ++m) {
+        ASSERT_EQ(r.false_pixels[m].size(), r.ceiling.size());
+        const core::FalsePixels& white = r.false_pixels[m][s][core::kWhite];
+        const core::ClassificationMetrics& adapted = r.segments[m][s].adapted;
+        EXPECT_EQ(white.classified, adapted.predictedCount(core::kWhite));
+        if (white.classified == 0) continue;
+        EXPECT_NEAR(static_cast<double>(white.shared + white.hall + white.other) / white.classified,
+                    1.0 - adapted.precision(core::kWhite), 1e-12);
+      }
     }
   }
   // Seed 0 is darkened at frame 16: its scene lines give the cycles each mode took to settle.
@@ -44,6 +57,9 @@ TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
   const std::string text = sim::formatReport(report);
   EXPECT_NE(text.find("ceiling"), std::string::npos);
   EXPECT_NE(text.find("F1 below the paper"), std::string::npos);
+  EXPECT_NE(text.find("false pixels in cells of the hall"), std::string::npos);
+  ASSERT_EQ(report.false_hall.size(), 2u);
+  EXPECT_EQ(report.false_hall[0][core::kWhite].count, report.precision[0][core::kWhite].count);
 }
 
 TEST(FamilyEvaluation, ALongSceneSummaryIsPrintedWholeOnItsOwnLine) {

@@ -8,6 +8,7 @@
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/metrics.hpp"
 #include "act_color/core/run_evaluation.hpp"
+#include "act_color/core/table_ceiling.hpp"
 #include "act_color/sim/scene_family.hpp"
 
 namespace act_color {
@@ -27,6 +28,7 @@ struct EvalOptions {
   size_t adapt_frames = 12;    // frames of each segment before "after adaptation"
   int bootstrap_cycles = 100;  // start-up training on the first frame, as act_replay
   std::string png_dir;         // when set: input | modes | truth of each segment's last frame
+  bool false_pixels = false;   // SceneResult::false_pixels (a pass over every pixel per mode)
 };
 
 // Issue 13's figures of the ball in one scene and mode. In scenes with a ball: pixels pooled over
@@ -61,6 +63,8 @@ struct SceneResult {
   double render_seconds = 0.0;
   double act_seconds = 0.0;       // training and classification, all modes
   std::vector<BallFigures> ball;  // [mode]
+  // With EvalOptions::false_pixels: [mode][segment], after adaptation, against the ceiling's table.
+  std::vector<std::vector<std::array<core::FalsePixels, core::kNumClasses>>> false_pixels;
 };
 
 SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>& modes, const EvalOptions& options);
@@ -93,6 +97,11 @@ struct FamilyReport {
   // over scenes without a ball, the fraction of frames with ball pixels.
   std::vector<Distribution> ball_recall, ball_precision, ball_position_ok, ball_seen, no_ball_false_frames;
   std::vector<size_t> no_ball_scenes_over_1pct;
+  // [mode][class], with EvalOptions::false_pixels (else empty): shares of the class's classified
+  // pixels that are false (1 - precision, taken apart by core::FalsePixelSources) in cells the
+  // ceiling gives the class too, in the hall's cells, in other classes' cells; and those of them
+  // in a cell at the top of a channel. 90th percentile in p10.
+  std::vector<std::array<Distribution, core::kNumClasses>> false_shared, false_hall, false_other, false_top;
 };
 
 FamilyReport summarize(const std::vector<SceneResult>& results);
