@@ -113,7 +113,7 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
   }
   // Only the parts attached to where no class is expected (looked at in fewer frames than
   // min_looked; the counts are whole numbers).
-  const cv::Mat looked(height, width, CV_16UC1, const_cast<uint16_t*>(looked_.data()));
+  const cv::Mat looked = cv::Mat(looked_).reshape(1, height);  // a view of the counts, no copy
   cv::Mat unlooked = looked < std::ceil(min_looked);
   cv::dilate(unlooked, unlooked,
              cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kAttachedPx + 1, 2 * kAttachedPx + 1)));
