@@ -1,5 +1,8 @@
 #include "act_color/core/table_ceiling.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace act_color {
@@ -110,6 +113,37 @@ std::array<FalsePixels, kNumClasses> FalsePixelSources::sources(const ColorLut& 
     }
   }
   return out;
+}
+
+RecallCost::RecallCost(int bits_per_channel, ColorSpace space) : index_(bits_per_channel, space) {
+  counts_.assign(index_.size(), std::array<uint32_t, 2>{});
+}
+
+void RecallCost::clear() { std::fill(counts_.begin(), counts_.end(), std::array<uint32_t, 2>{}); }
+
+double RecallCost::leastUnwantedShare(double recall) const {
+  std::vector<std::array<uint32_t, 2>> cells;  // the cells with wanted pixels: no other is worth taking
+  uint64_t wanted = 0, unwanted = 0;
+  for (const auto& n : counts_) {
+    wanted += n[0];
+    unwanted += n[1];
+    if (n[0] > 0) cells.push_back(n);
+  }
+  if (wanted == 0 || unwanted == 0) return -1.0;
+  const auto need = static_cast<size_t>(std::ceil(std::clamp(recall, 0.0, 1.0) * static_cast<double>(wanted) - 1e-9));
+  // A knapsack over whole cells: least[w] is the fewest unwanted pixels of a set of cells with at
+  // least w wanted ones (w capped at the need).
+  constexpr uint64_t kNone = std::numeric_limits<uint64_t>::max();
+  std::vector<uint64_t> least(need + 1, kNone);
+  least[0] = 0;
+  for (const auto& n : cells) {
+    for (size_t w = need + 1; w-- > 0;) {
+      if (least[w] == kNone) continue;
+      const size_t to = std::min<size_t>(need, w + n[0]);
+      least[to] = std::min(least[to], least[w] + n[1]);
+    }
+  }
+  return static_cast<double>(least[need]) / static_cast<double>(unwanted);
 }
 
 }  // namespace core

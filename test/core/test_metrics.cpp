@@ -109,3 +109,26 @@ TEST(FalsePixelSources, TakesAClassifiersFalsePixelsApartByTheCeilingsCells) {
   EXPECT_THROW(sources.add(view, labels, cv::Mat::zeros(2, 10, CV_8UC1)), std::invalid_argument);
   EXPECT_THROW(sources.add(view, cv::Mat::zeros(1, 9, CV_8UC1), truth), std::invalid_argument);
 }
+
+TEST(RecallCost, LeastUnwantedShareOfAnyTableAtARecall) {
+  // Three cells: a (wanted 6, unwanted 0), b (wanted 3, unwanted 1), c (wanted 1, unwanted 9).
+  const uint8_t a[3] = {240, 240, 240}, b[3] = {200, 200, 200}, c[3] = {255, 255, 255};
+  RecallCost cost;
+  EXPECT_EQ(cost.leastUnwantedShare(0.5), -1.0);
+  for (int i = 0; i < 6; ++i) cost.addWanted(a);
+  EXPECT_EQ(cost.leastUnwantedShare(0.5), -1.0);  // nothing unwanted: no share to give
+  for (int i = 0; i < 3; ++i) cost.addWanted(b);
+  cost.addWanted(c);
+  cost.addUnwanted(b);
+  for (int i = 0; i < 9; ++i) cost.addUnwanted(c);
+  EXPECT_DOUBLE_EQ(cost.leastUnwantedShare(0.5), 0.0);  // a alone holds 6 of the 10 wanted
+  EXPECT_DOUBLE_EQ(cost.leastUnwantedShare(0.6), 0.0);
+  // 0.8 and 0.9: a and the whole of b (a table has no part of a cell), one unwanted pixel.
+  EXPECT_NEAR(cost.leastUnwantedShare(0.8), 1.0 / 10.0, 1e-12);
+  EXPECT_NEAR(cost.leastUnwantedShare(0.9), 1.0 / 10.0, 1e-12);
+  cost.addWanted(c);                                             // c: 2 wanted, 9 unwanted; 11 wanted in all
+  EXPECT_NEAR(cost.leastUnwantedShare(0.8), 1.0 / 10.0, 1e-12);  // 9 of 11: a and b
+  EXPECT_NEAR(cost.leastUnwantedShare(0.9), 1.0, 1e-12);         // 10 of 11: c too (a and c alone: 8)
+  cost.clear();
+  EXPECT_EQ(cost.leastUnwantedShare(0.5), -1.0);
+}

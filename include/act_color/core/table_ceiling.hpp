@@ -66,5 +66,26 @@ class FalsePixelSources {
   std::vector<std::array<uint32_t, kNumClasses>> classified_, right_;
 };
 
+// What a fixed table must give away to reach a recall: from the colors of one class's pixels
+// ("wanted") and of pixels it must not take ("unwanted", e.g. the hall), the least share of the
+// unwanted pixels that any fixed table classifies as the class while it classifies at least a
+// given share of the wanted ones as the class (exact: a knapsack over the cells). A saturated line
+// and a saturated wall are one cell: then the share is large whatever a trainer does.
+class RecallCost {
+ public:
+  explicit RecallCost(int bits_per_channel = 6, ColorSpace space = ColorSpace::kRgb);
+
+  void addWanted(const uint8_t c[3]) { ++counts_[index_.index(c[0], c[1], c[2])][0]; }
+  void addUnwanted(const uint8_t c[3]) { ++counts_[index_.index(c[0], c[1], c[2])][1]; }
+  void clear();
+  // The least unwanted share at `recall` (0-1) of the wanted pixels; -1 without wanted or
+  // unwanted pixels.
+  double leastUnwantedShare(double recall) const;
+
+ private:
+  ColorLut index_;
+  std::vector<std::array<uint32_t, 2>> counts_;  // per cell: wanted, unwanted
+};
+
 }  // namespace core
 }  // namespace act_color

@@ -65,6 +65,10 @@ struct RealVariantResult {
   // NuBot's fixed table on the image and on the changed image (white_recall unused; -1: no table).
   RealFrameFigures nubot_before{-1, -1, -1};
   RealFrameFigures nubot_after{-1, -1, -1};
+  // The least share of the hall that any fixed 6-bit table classifies white while it classifies
+  // half the hand-picked line pixels white, on the averaged frames before and after the change
+  // (core::RecallCost; -1: no hand-picked pixels). The same in every mode.
+  double table_hall_at_half_white_before = -1, table_hall_at_half_white_after = -1;
 };
 
 struct RealImageResult {
