@@ -62,7 +62,15 @@ std::vector<SegmentSummary> RunEvaluation::segments() const {
       }
       seg.final_recall[k] = n ? sum / n : std::nan("");
       seg.settle_cycles[k] = -1;
+      seg.reach_cycles[k] = -1;
       if (!n) continue;
+      for (size_t f = seg.first_frame; f < end; ++f) {
+        const double r = frame_metrics_[f].recall(k);
+        if (!std::isnan(r) && r >= seg.final_recall[k] - settle_tolerance_) {
+          seg.reach_cycles[k] = static_cast<int>(f - seg.first_frame) + 1;
+          break;
+        }
+      }
       // The last frame before which recall was below final - tolerance.
       size_t settle = seg.first_frame;
       for (size_t f = seg.first_frame; f < end; ++f) {

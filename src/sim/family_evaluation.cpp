@@ -57,6 +57,12 @@ int settleCycles(const core::SegmentSummary& ss, int k) {
   return ss.settle_cycles[k] < 0 ? static_cast<int>(ss.frames) : ss.settle_cycles[k];
 }
 
+// The same for the cycles until recall first comes within the tolerance (reach_cycles).
+int reachCycles(const core::SegmentSummary& ss, int k) {
+  if (settleCycles(ss, k) < 0) return -1;
+  return ss.reach_cycles[k] < 0 ? static_cast<int>(ss.frames) : ss.reach_cycles[k];
+}
+
 // The trained classes and the ball.
 const std::vector<int>& reportedClasses() {
   static const std::vector<int> classes = [] {
@@ -223,7 +229,7 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
   const size_t with_ceiling = modes + 1;
   using Values = std::array<std::vector<double>, core::kNumClasses>;
   std::vector<Values> recall(with_ceiling), precision(with_ceiling), recall_gap(modes), precision_gap(modes),
-      settle(modes), false_shared(modes), false_hall(modes), false_other(modes), false_top(modes);
+      settle(modes), reach(modes), false_shared(modes), false_hall(modes), false_other(modes), false_top(modes);
   r.f1_below_paper.assign(modes, {});
   r.f1_worst_vs_paper.assign(modes, {});
   r.worst_recall_seed.assign(modes, {});
@@ -267,6 +273,7 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
             r.f1_worst_vs_paper[m][k] = std::min(r.f1_worst_vs_paper[m][k], diff);
           }
           if (const int cycles = settleCycles(ss, k); cycles >= 0) settle[m][k].push_back(cycles);
+          if (const int cycles = reachCycles(ss, k); cycles >= 0) reach[m][k].push_back(cycles);
           if (m < s.false_pixels.size() && seg < s.false_pixels[m].size()) {
             const core::FalsePixels& fp = s.false_pixels[m][seg][k];
             const double n = std::max<double>(1.0, static_cast<double>(fp.classified));
@@ -321,6 +328,7 @@ FamilyReport summarize(const std::vector<SceneResult>& results) {
   r.recall_gap = fill(recall_gap, false);
   r.precision_gap = fill(precision_gap, false);
   r.settle = fill(settle, false);
+  r.reach = fill(reach, false);
   if (!results.front().false_pixels.empty()) {
     r.false_shared = fill(false_shared, false);
     r.false_hall = fill(false_hall, false);
@@ -366,6 +374,8 @@ std::string formatReport(const FamilyReport& r) {
   table("precision gap to the ceiling", r.precision_gap, false, "median p90 worst; ceiling - mode");
   table("cycles to settle after a sudden change of light", r.settle, false,
         "median p90 worst; within 0.02 of the final recall; never settled = segment length");
+  table("cycles until recall first comes within 0.02 of its final level after such a change", r.reach, false,
+        "median p90 worst; it may leave it again (settle counts the last return); never = segment length");
   if (!r.false_shared.empty()) {
     const char* columns = "median p90 worst; share of the pixels classified as the class";
     table("false pixels in cells the ceiling gives the class too", r.false_shared, false, columns);

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "act_color/core/metrics.hpp"
+#include "act_color/core/run_evaluation.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/core/table_ceiling.hpp"
 
@@ -131,4 +132,25 @@ TEST(RecallCost, LeastUnwantedShareOfAnyTableAtARecall) {
   EXPECT_NEAR(cost.leastUnwantedShare(0.9), 1.0, 1e-12);         // 10 of 11: c too (a and c alone: 8)
   cost.clear();
   EXPECT_EQ(cost.leastUnwantedShare(0.5), -1.0);
+}
+
+TEST(RunEvaluation, ReachIsTheFirstFrameWithinTheToleranceSettleTheLastReturn) {
+  // Ten line pixels a frame; after the event white's recall goes 0.5, 0.9, 0.7, 0.9, 0.9, 0.9, 0.9,
+  // 0.9 (final: the last quarter's mean, 0.9): reached in 2 cycles, settled in 4.
+  RunEvaluation evaluation;
+  const cv::Mat truth(1, 10, CV_8UC1, cv::Scalar(kWhite));
+  auto frame = [&](int white) {
+    cv::Mat labels(1, 10, CV_8UC1, cv::Scalar(kGreen));
+    labels.colRange(0, white).setTo(kWhite);
+    evaluation.addFrame(labels, truth);
+  };
+  frame(9);
+  evaluation.markEvent("darken");
+  for (int white : {5, 9, 7, 9, 9, 9, 9, 9}) frame(white);
+  const std::vector<SegmentSummary> segments = evaluation.segments();
+  ASSERT_EQ(segments.size(), 2u);
+  EXPECT_NEAR(segments[1].final_recall[kWhite], 0.9, 1e-12);
+  EXPECT_EQ(segments[1].reach_cycles[kWhite], 2);
+  EXPECT_EQ(segments[1].settle_cycles[kWhite], 4);
+  EXPECT_EQ(segments[1].reach_cycles[kGreen], -1);  // no green in the truth
 }

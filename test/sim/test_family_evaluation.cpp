@@ -54,7 +54,20 @@ TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
     EXPECT_LE(report.recall[0][k].p10, report.recall[0][k].median);
     EXPECT_GE(report.recall_gap[0][k].worst, report.recall_gap[0][k].median);
   }
+  // Recall comes within the tolerance no later than it stays there, after every sudden change.
+  for (size_t m = 0; m < 2; ++m) {
+    for (const sim::SceneResult& r : results) {
+      for (const core::SegmentSummary& ss : r.segments[m]) {
+        if (ss.settle_cycles[core::kWhite] < 0) continue;
+        EXPECT_GE(ss.reach_cycles[core::kWhite], 1);
+        EXPECT_LE(ss.reach_cycles[core::kWhite], ss.settle_cycles[core::kWhite]);
+      }
+    }
+    EXPECT_EQ(report.reach[m][core::kWhite].count, report.settle[m][core::kWhite].count);
+    EXPECT_LE(report.reach[m][core::kWhite].median, report.settle[m][core::kWhite].median);
+  }
   const std::string text = sim::formatReport(report);
+  EXPECT_NE(text.find("cycles until recall first comes within 0.02"), std::string::npos);
   EXPECT_NE(text.find("ceiling"), std::string::npos);
   EXPECT_NE(text.find("F1 below the paper"), std::string::npos);
   EXPECT_NE(text.find("false pixels in cells of the hall"), std::string::npos);

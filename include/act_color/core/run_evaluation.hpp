@@ -23,6 +23,10 @@ struct SegmentSummary {
   // of final_recall (1: the first frame after the event, trained once, is already there); -1 when
   // the class is absent or never settles.
   std::array<int, kNumClasses> settle_cycles{};
+  // Training cycles after the event until the class's per-frame recall first comes within the
+  // tolerance of final_recall (it may leave it again later: settle_cycles counts the last
+  // return); -1 when the class is absent or never comes there.
+  std::array<int, kNumClasses> reach_cycles{};
 };
 
 // Collects per-frame accuracy of a run and splits it into segments at events.

@@ -87,6 +87,10 @@ struct FamilyReport {
   std::vector<std::array<Distribution, core::kNumClasses>> recall_gap, precision_gap;
   // [mode][class]: settle cycles after events (never settled counts as the segment's length).
   std::vector<std::array<Distribution, core::kNumClasses>> settle;
+  // [mode][class]: cycles after those events until recall first comes within 0.02 of its final
+  // level (core::SegmentSummary::reach_cycles; never = segment length). Far below settle when
+  // recall gets there at once and later leaves it again (the table's cells come and go).
+  std::vector<std::array<Distribution, core::kNumClasses>> reach;
   // [mode][class]: units whose F1 is below the paper's F1 - 0.02, and the worst difference.
   std::vector<std::array<size_t, core::kNumClasses>> f1_below_paper;
   std::vector<std::array<double, core::kNumClasses>> f1_worst_vs_paper;
