@@ -70,9 +70,11 @@ TEST(RealImages, Nubot1) {
   // pixels are white (core::RecallCost; measured 0.01 before each change, 0.18 after the 1.5x
   // brightening, whose saturated line cores share a cell with the hall's saturated walls).
   for (const auto& row : r.rows) {
-    EXPECT_LT(row.table_hall_at_half_white_before, 0.05) << row.variant;
+    EXPECT_LT(row.table_hall_as_white_before, 0.05) << row.variant;
+    EXPECT_GE(row.table_hall_as_green_before, 0.0) << row.variant;
+    EXPECT_LT(row.table_hall_as_green_before, 0.05) << row.variant;
     if (row.variant == "brighten") {
-      EXPECT_GT(row.table_hall_at_half_white_after, 0.15);
+      EXPECT_GT(row.table_hall_as_white_after, 0.15);
     }
   }
 }
