@@ -68,7 +68,7 @@ struct RealVariantResult {
   // The least share of the hall that any fixed 6-bit table classifies white while it classifies
   // half the hand-picked line pixels white, and green while it classifies 88% of the carpet pixels
   // green (issue 11's targets), on the averaged frames before and after the change
-  // (core::RecallCost; -1: no hand-picked pixels). The same in every mode.
+  // (core::RecallCost; white -1 without hand-picked pixels). The same in every mode.
   double table_hall_as_white_before = -1, table_hall_as_white_after = -1;
   double table_hall_as_green_before = -1, table_hall_as_green_after = -1;
 };
