@@ -64,18 +64,17 @@ std::vector<SegmentSummary> RunEvaluation::segments() const {
       seg.settle_cycles[k] = -1;
       seg.reach_cycles[k] = -1;
       if (!n) continue;
-      for (size_t f = seg.first_frame; f < end; ++f) {
-        const double r = frame_metrics_[f].recall(k);
-        if (!std::isnan(r) && r >= seg.final_recall[k] - settle_tolerance_) {
-          seg.reach_cycles[k] = static_cast<int>(f - seg.first_frame) + 1;
-          break;
-        }
-      }
-      // The last frame before which recall was below final - tolerance.
+      // The first frame at or above final - tolerance, and the last frame before which recall was
+      // below it.
       size_t settle = seg.first_frame;
       for (size_t f = seg.first_frame; f < end; ++f) {
         const double r = frame_metrics_[f].recall(k);
-        if (!std::isnan(r) && r < seg.final_recall[k] - settle_tolerance_) settle = f + 1;
+        if (std::isnan(r)) continue;
+        if (r < seg.final_recall[k] - settle_tolerance_) {
+          settle = f + 1;
+        } else if (seg.reach_cycles[k] < 0) {
+          seg.reach_cycles[k] = static_cast<int>(f - seg.first_frame) + 1;
+        }
       }
       if (settle < end) seg.settle_cycles[k] = static_cast<int>(settle - seg.first_frame) + 1;
     }

@@ -147,6 +147,7 @@ RealImageResult evaluateRealImage(const RealImage& image,
     // The frames (their noise too) are the same in every mode: the bound is taken in the first.
     core::RecallCost white_before, white_after, green_before, green_after;
     for (const auto& [mode_name, params] : modes) {
+      const bool first_mode = &mode_name == &modes.front().first;
       core::ActTrainer trainer(cal, params);
       cv::RNG rng(seed);
       std::vector<RealFrameFigures> figures;
@@ -160,12 +161,11 @@ RealImageResult evaluateRealImage(const RealImage& image,
         noisy.convertTo(frame, CV_8UC3);  // saturates
         const core::ImageView view = core::ImageView::fromMat(frame, core::PixelFormat::kRgb8);
         const bool averaged = f >= kRealFramesBefore - kAveragedFrames && f < kRealFramesBefore;
-        if (mode_name == modes.front().first &&
-            (averaged || f >= kRealFramesAfter + kRealFramesBefore - kAveragedFrames)) {
+        if (first_mode && (averaged || f >= kRealFramesAfter + kRealFramesBefore - kAveragedFrames)) {
           core::RecallCost& white = averaged ? white_before : white_after;
           core::RecallCost& green = averaged ? green_before : green_after;
           auto color = [&](int i) { return frame.ptr<uint8_t>(i / frame.cols) + 3 * (i % frame.cols); };
-          for (const cv::Point& p : whites) white.addWanted(frame.ptr<uint8_t>(p.y) + 3 * p.x);
+          for (const cv::Point& p : whites) white.addWanted(color(p.y * frame.cols + p.x));
           for (const int i : carpet) green.addWanted(color(i));
           for (const int i : hall) {
             white.addUnwanted(color(i));
@@ -365,15 +365,13 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
         const bool white = row.table_hall_as_white_before >= 0;
         const double before = row.table_hall_as_green_before + std::max(0.0, row.table_hall_as_white_before);
         const double after = row.table_hall_as_green_after + std::max(0.0, row.table_hall_as_white_after);
-        char parts[96] = "least; green";
+        char parts[96] = "least; green", white_target[32] = "-";
         if (white) {
           std::snprintf(parts, sizeof(parts), "least; white %.2f / %.2f, green %.2f / %.2f",
                         row.table_hall_as_white_before, row.table_hall_as_white_after, row.table_hall_as_green_before,
                         row.table_hall_as_green_after);
-        }
-        char white_target[32] = "-";
-        if (white)
           std::snprintf(white_target, sizeof(white_target), "%.2f / %.2f", kTargetWhiteRecall, kTargetWhiteRecall);
+        }
         std::snprintf(line, sizeof(line), "| %s | any fixed table | %s | - | %.2f / %.2f | %.2f / %.2f (%s) |\n",
                       row.variant.c_str(), white_target, kTargetGreenRecall, kTargetGreenRecall, before, after, parts);
         out << line;
