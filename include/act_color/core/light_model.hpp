@@ -13,7 +13,9 @@ namespace core {
 // color through one monotone (non-decreasing) function per channel. ACT estimates that function
 // from the pixels whose class the pose tells best: the carpet, the lines (eq. 1) and the own
 // chassis, whose per-channel quantiles are anchors, before (a running reference) and after.
-// Between the anchors the function is linear; beyond them it continues the nearest segment.
+// The anchors are first moved onto the curve y = a + b 255 (x / 255)^gamma that fits them (one
+// misleading anchor left out), which the function then follows; when no such curve fits, the
+// function is linear between the anchors as seen. Beyond them it continues the nearest segment.
 class LightModel {
  public:
   // f(x) for x = 0 ... 256 (the upper end of the last color value), per channel.
