@@ -9,14 +9,14 @@
 namespace act_color {
 namespace sim {
 
-FlickerFrames steadyLightFrames(const FamilyScene& scene, size_t count) {
+FlickerFrames steadyLightFrames(const FamilyScene& scene, size_t count, uint32_t noise_offset) {
   const Renderer renderer(scene.calibration, scene.renderer);
   const Lighting light = scene.scenario.frames[0].scene.lighting;
   FlickerFrames out;
   for (size_t i = 0; i < count; ++i) {
     Scene s = scene.scenario.frames[std::min(i, scene.scenario.frames.size() - 1)].scene;
     s.lighting = light;
-    s.noise_seed = static_cast<uint32_t>(i + 1);
+    s.noise_seed = static_cast<uint32_t>(i + 1) + noise_offset;
     out.frames.push_back(renderer.render(s));
     out.poses.push_back(s.robot_pose);
   }

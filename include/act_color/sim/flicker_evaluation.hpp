@@ -17,7 +17,9 @@ struct FlickerFrames {
   std::vector<LabeledFrame> frames;
   std::vector<core::Pose2D> poses;
 };
-FlickerFrames steadyLightFrames(const FamilyScene& scene, size_t count);
+// noise_offset: another realisation of the sensor noise (the same motion and light), for a control
+// run that shows how far two steady runs differ by chance.
+FlickerFrames steadyLightFrames(const FamilyScene& scene, size_t count, uint32_t noise_offset = 0);
 
 struct FlickerRun {
   std::vector<double> fill;                            // mapped table cells / all cells, per frame
