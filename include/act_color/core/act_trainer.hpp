@@ -46,8 +46,8 @@ struct ActParams {
   // the table, so that all classes follow at once instead of re-learning from sparse samples.
   // Anchors that do not move as one light would move them are left to the clusters.
   bool light_compensation = true;
-  // In the cycle of such a change of light and the two after it every n-th pixel is added (instead
-  // of add_stride), so that what the moved table misses is filled at once (ActTrainer's
+  // In the cycle of such a change of light and the seven after it every n-th pixel is added
+  // (instead of add_stride), so that what the moved table misses is filled at once (ActTrainer's
   // kDenseAddCycles).
   int light_change_add_stride = 50;
   // A cell confirmed by an in-field sample of its class (within zeta * sigma) in the last n
@@ -309,8 +309,9 @@ class ActTrainer {
   std::unordered_map<int, int> sampling_strides_;
   int add_weight_ = 1;              // pixels one in-field sample stands for in this cycle
   uint64_t last_light_change_ = 0;  // revision_ + 1 of the last change of light; 0: none
-  // This cycle adds at light_change_add_stride (a change of light's cycle or one of the two after
-  // it); its additions fill their cells' neighbourhoods unless it is one of the later two.
+  // This cycle adds at light_change_add_stride (a change of light's cycle or one of the
+  // kDenseAddCycles - 1 after it); its additions fill their cells' neighbourhoods only in the
+  // change's own cycle.
   bool denseAddCycle() const;
   bool addsNeighbourhoods() const;
   // The removal step's samples start, start + remove_stride, ... that can ever be off the field,
