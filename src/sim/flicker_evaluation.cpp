@@ -69,6 +69,15 @@ const std::vector<double>& steadyReferenceGains() {
   return gains;
 }
 
+std::vector<FlickerRun> playSteadyReferences(const FamilyScene& scene, const FlickerFrames& frames,
+                                             const core::ActParams& params) {
+  std::vector<FlickerRun> references;
+  for (const double gain : steadyReferenceGains()) {
+    references.push_back(playWithGains(scene, frames, std::vector<double>(frames.frames.size(), gain), params));
+  }
+  return references;
+}
+
 FlickerComparison compareWithSteadyLight(const FlickerRun& run, const std::vector<double>& gains,
                                          const std::vector<FlickerRun>& references, size_t first) {
   const std::vector<double>& levels = steadyReferenceGains();

@@ -48,6 +48,9 @@ FlickerComparison compareWithSteadyLight(const FlickerRun& run, const std::vecto
                                          const std::vector<FlickerRun>& references, size_t first);
 // The gains of the references compareWithSteadyLight expects, in its order.
 const std::vector<double>& steadyReferenceGains();
+// Those references: the frames played at each of those gains throughout.
+std::vector<FlickerRun> playSteadyReferences(const FamilyScene& scene, const FlickerFrames& frames,
+                                             const core::ActParams& params = core::ActParams());
 
 }  // namespace sim
 }  // namespace act_color
