@@ -343,11 +343,11 @@ ClusterParams ActTrainer::clusterParams() const {
   return p;
 }
 
-uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k) {
+uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k, bool ball_sighting) {
   const ClassCluster& cluster = clusters_[k];
   const Eigen::Vector3d color(c[0], c[1], c[2]);
   const double radius = params_.zeta * cluster.sigma();
-  if ((cluster.mean() - color).norm() >= radius) return 0;  // 2.3: |mu_k - c| < zeta sigma_k
+  if (!ball_sighting && (cluster.mean() - color).norm() >= radius) return 0;  // 2.3: |mu_k - c| < zeta sigma_k
   uint32_t changed = 0;
   const uint32_t cell = lut_.index(c[0], c[1], c[2]);
   // The ball never takes a color of another class (a goal's, the carpet's, a line's, a robot's).
@@ -1060,7 +1060,10 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
     for (size_t j = 0; j < b.members.size(); j += step) {
       uint8_t c[3];
       image.color(static_cast<int>(b.members[j] % image.width), static_cast<int>(b.members[j] / image.width), c);
-      stats.added[kOrange] += addColor(c, kOrange);
+      // All of them, not only those within zeta sigma: a shaded sphere's dark side and highlight lie
+      // beyond its cluster's sigma (tuning split: ball F1 median 0.55 -> 0.59, 13 of 14 changed
+      // segments up).
+      stats.added[kOrange] += addColor(c, kOrange, true);
     }
   };
   if (seen) {

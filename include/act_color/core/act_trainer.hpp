@@ -186,8 +186,10 @@ class ActTrainer {
 
  private:
   ClusterParams clusterParams() const;
-  // 2.3 for one color; returns the number of cells that changed to class k.
-  uint32_t addColor(const uint8_t c[3], uint8_t k);
+  // 2.3 for one color; returns the number of cells that changed to class k. A pixel of a ball
+  // sighting (`ball_sighting`) is the ball's by the blob's shape, not by the cluster: it is added
+  // without 2.3's zeta sigma test.
+  uint32_t addColor(const uint8_t c[3], uint8_t k, bool ball_sighting = false);
   // ActParams::nearest_mean: another trained cluster's mean is nearer to the color than k's.
   // Uses the boundaries from prepareNearestMean(), made after this cycle's cluster update.
   bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
