@@ -632,11 +632,23 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
   const double width = 1 << (8 - bits);
   warped_.assign(lut_.size(), kUnknown);
   warped_neighbour_only_.assign(neighbour_only_.begin(), neighbour_only_.end());
-  warped_evidence_.assign(evidence_.begin(), evidence_.end());
+  // The counts move with their colors too, a class's cell or not: a color seen in the field (or off
+  // it) under the old light is seen there, mapped, under the new one. A cell takes the sum of the
+  // counts of the cells that map to it, each cell's counts shared among the cells it maps to:
+  // where the map compresses the colors, the sum is what the cell will count under the new light,
+  // and the moved cells are not removed on the first sightings off the field before their own
+  // counts have grown. (Counts copied from the last cell that mapped to a cell, and those of cells
+  // of no class left where they were: the lines took 24 cycles to come back after the paper's
+  // darkening on nubot_1 instead of 1; on the tuning split white and black took 5.5 and 10
+  // cycles to settle after a sudden change (medians) instead of 2 and 1.)
+  const uint32_t now = static_cast<uint32_t>(revision_ + 1);
+  warped_evidence_.assign(evidence_.size(), Evidence{0.f, 0.f, now});
   const uint32_t mask = (1u << bits) - 1;
   for (uint32_t cell = 0; cell < lut_.size(); ++cell) {
     const uint8_t k = lut_.at(cell);
-    if (k == kUnknown || k >= kNumClasses) continue;
+    const bool classed = k != kUnknown && k < kNumClasses;
+    if (!classed && evidence_[cell].in_field == 0.f && evidence_[cell].off_field == 0.f) continue;
+    const Evidence counts = evidence(cell);
     int first[3], last[3];
     const uint32_t channel_cells[3] = {cell >> (2 * bits), (cell >> bits) & mask, cell & mask};
     for (int ch = 0; ch < 3; ++ch) {
@@ -650,13 +662,18 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
       first[ch] = std::clamp(first[ch], 0, cells - 1);
       last[ch] = std::clamp(last[ch], first[ch], cells - 1);
     }
+    const float share =
+        1.f / static_cast<float>((last[0] - first[0] + 1) * (last[1] - first[1] + 1) * (last[2] - first[2] + 1));
     for (int a = first[0]; a <= last[0]; ++a) {
       for (int b = first[1]; b <= last[1]; ++b) {
         for (int d = first[2]; d <= last[2]; ++d) {
           const uint32_t target = lut_.cellIndex(a, b, d);
-          warped_[target] = k;
-          warped_neighbour_only_[target] = neighbour_only_[cell];
-          warped_evidence_[target] = evidence_[cell];
+          if (classed) {
+            warped_[target] = k;
+            warped_neighbour_only_[target] = neighbour_only_[cell];
+          }
+          warped_evidence_[target].in_field += share * counts.in_field;
+          warped_evidence_[target].off_field += share * counts.off_field;
         }
       }
     }
@@ -664,7 +681,6 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
   lut_.assign(warped_);
   rebuildMapped();
   neighbour_only_.swap(warped_neighbour_only_);
-  // The counts move with their cells: colors seen in the field stay so under the new light.
   evidence_.swap(warped_evidence_);
   // Confirmations were made under the old light: colors of the old light that now show up off the
   // field must not be protected from removal.
