@@ -45,7 +45,7 @@ const char* const kUsage =
     "  --max-residual M      reject above this median line-pixel residual (default 0.05 m)\n"
     "  --min-inliers F       reject below this fraction of line pixels on the carpet within 0.08 m\n"
     "                        (default 0.7)\n"
-    "  --max-carpet-on-lines F  reject when more of the carpet lands on the model's lines (default 0.03)\n"
+    "  --max-carpet-on-lines F  reject when more of the carpet lands on the model's lines (default 0.02)\n"
     "  --output CAL.yaml     write the calibration (validated first)\n"
     "  --overlay OUT.png     the image with the model's lines (magenta) and the line pixels found\n"
     "  --whites FILE         also measure hand-picked line pixels ('x y' per line, NuBot's whites.txt)\n"
