@@ -48,7 +48,9 @@ class ActTrainerNodelet : public nodelet::Nodelet {
 
  private:
   // What became of an image (diagnostics).
-  enum class Outcome { kTrained, kStartup, kNoPose, kRejected };
+  // kContradicted: the cycle ran, but the table contradicted the pose and nothing was trained
+  // (ActParams::pose_check).
+  enum class Outcome { kTrained, kStartup, kNoPose, kRejected, kContradicted };
   struct Pending {
     sensor_msgs::ImageConstPtr image;
     ros::WallTime arrival;
@@ -160,7 +162,7 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   std::deque<Pending> pending_;
   ros_conversions::TimeJumpDetector image_time_;
   // Statistics for diagnostics: totals since the start (or the last time jump) ...
-  uint64_t images_ = 0, cycles_ = 0, skipped_ = 0, rejected_ = 0, time_jumps_ = 0;
+  uint64_t images_ = 0, cycles_ = 0, skipped_ = 0, rejected_ = 0, contradicted_ = 0, time_jumps_ = 0;
   double startup_ms_ = 0.0;
   std::string last_skip_reason_, last_reject_reason_;
   core::CycleStats last_stats_;
@@ -235,6 +237,7 @@ bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) 
                     readParam(pnh_, "evidence_removal_ratio", &p.evidence_removal_ratio, error) &&
                     readParam(pnh_, "learned_boundary", &p.learned_boundary, error) &&
                     readParam(pnh_, "lattice_sampling", &p.lattice_sampling, error) &&
+                    readParam(pnh_, "pose_check", &p.pose_check, error) &&
                     readParam(pnh_, "ball_training", &p.ball_training, error) &&
                     readParam(pnh_, "ball_diameter_m", &p.ball_diameter_m, error);
   if (!read) return false;
@@ -454,6 +457,7 @@ ActTrainerConfig ActTrainerNodelet::configInEffect() const {
   c.evidence_removal_ratio = p.evidence_removal_ratio;
   c.learned_boundary = p.learned_boundary;
   c.lattice_sampling = p.lattice_sampling;
+  c.pose_check = p.pose_check;
   c.ball_training = p.ball_training;
   c.ball_diameter_m = p.ball_diameter_m;
   c.max_pose_age = max_pose_age_s_;
@@ -483,6 +487,7 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
   p.evidence_removal_ratio = c.evidence_removal_ratio;
   p.learned_boundary = c.learned_boundary;
   p.lattice_sampling = c.lattice_sampling;
+  p.pose_check = c.pose_check;
   p.ball_training = c.ball_training;
   p.ball_diameter_m = c.ball_diameter_m;
   try {
@@ -557,7 +562,7 @@ void ActTrainerNodelet::onTimeJump(const ros::Time& from, const ros::Time& to) {
   pending_.clear();
   window_.clear();
   fill_history_.clear();
-  images_ = cycles_ = skipped_ = rejected_ = 0;
+  images_ = cycles_ = skipped_ = rejected_ = contradicted_ = 0;
   last_skip_reason_.clear();
   last_reject_reason_.clear();
   if (reset_on_time_jump_) {
@@ -620,7 +625,14 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
     outcome = Outcome::kStartup;
   } else if (have_pose) {
     last_stats_ = trainer_->cycle(view, pose);
-    outcome = Outcome::kTrained;
+    outcome = last_stats_.pose_contradicted ? Outcome::kContradicted : Outcome::kTrained;
+    if (last_stats_.pose_contradicted) {
+      ++contradicted_;
+      ACT_WALL_THROTTLE(5.0, NODELET_WARN("no training on the image stamped %.3f: %.0f%% of its samples contradict the "
+                                          "color table at the pose (%.2f, %.2f, %.2f); is the localization wrong?",
+                                          msg->header.stamp.toSec(), 100.0 * last_stats_.contradiction, pose.x_m,
+                                          pose.y_m, pose.theta_rad));
+    }
     if (last_stats_.ball.seen) {
       geometry_msgs::PointStamped ball;
       ball.header.stamp = msg->header.stamp;
@@ -640,7 +652,7 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
   if (outcome == Outcome::kStartup) {
     has_table_ = true;
     startup_ms_ = cycle_ms;
-  } else if (outcome == Outcome::kTrained) {
+  } else if (outcome == Outcome::kTrained || outcome == Outcome::kContradicted) {
     has_table_ = true;
     ++cycles_;
   }
@@ -951,13 +963,14 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   }
   const ros::WallTime now = ros::WallTime::now();
   window_.trim(now);
-  size_t trained = 0, no_pose = 0, rejected = 0, cycles = 0, latencies = 0;
+  size_t trained = 0, no_pose = 0, rejected = 0, contradicted = 0, cycles = 0, latencies = 0;
   double sum_ms = 0, max_ms = 0, sum_latency = 0, max_latency = 0;
   for (const Record& r : window_) {
     if (r.outcome == Outcome::kRejected) ++rejected;
     if (r.outcome == Outcome::kNoPose) ++no_pose;
+    if (r.outcome == Outcome::kContradicted) ++contradicted;
     if (r.outcome == Outcome::kTrained || r.outcome == Outcome::kStartup) ++trained;
-    if (r.outcome == Outcome::kTrained) {  // the start-up training is reported apart
+    if (r.outcome == Outcome::kTrained || r.outcome == Outcome::kContradicted) {  // the start-up training apart
       ++cycles;
       sum_ms += r.cycle_ms;
       max_ms = std::max(max_ms, r.cycle_ms);
@@ -997,7 +1010,13 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
       status.mergeSummary(DiagnosticStatus::WARN, m.str());
       m.str("");
     }
-    if (n > rejected && trained == 0) {
+    if (contradicted > 0) {
+      m << "the pose contradicted the color table in " << contradicted << " of " << n << " images in " << kWindowS
+        << " s (no training on them): is the localization wrong?";
+      status.mergeSummary(DiagnosticStatus::WARN, m.str());
+      m.str("");
+    }
+    if (n > rejected + contradicted && trained == 0) {
       status.mergeSummary(DiagnosticStatus::ERROR, "not training: " + last_skip_reason_);
     } else if (no_pose > 0 && trained < 0.9 * (n - rejected)) {
       m << "only " << percent(trained, n - rejected) << "% of the images trained: " << last_skip_reason_;
@@ -1016,6 +1035,7 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("trained (%, last 5 s)", percent(trained, n));
   status.add("rejected (%, last 5 s)", percent(rejected, n));
   status.add("without pose (%, last 5 s)", percent(no_pose, n));
+  status.add("pose contradicted by the table (%, last 5 s)", percent(contradicted, n));
   status.add("cycle time mean (ms, last 5 s)", cycles ? sum_ms / cycles : 0.0);
   status.add("cycle time max (ms, last 5 s)", max_ms);
   status.add("start-up training (ms)", startup_ms_);
@@ -1025,6 +1045,7 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("cycles", cycles_);
   status.add("images without training (no pose)", skipped_);
   status.add("images rejected", rejected_);
+  status.add("images not trained (pose contradicted by the table)", contradicted_);
   status.add("images waiting for their pose", pending_.size());
   status.add("last skip reason", last_skip_reason_);
   status.add("last rejection", last_reject_reason_);

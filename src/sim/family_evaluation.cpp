@@ -112,6 +112,7 @@ std::vector<EvalMode> evalModes(bool ablations) {
       {"evidence_removal_ratio", [](core::ActParams& p) { p.evidence_removal_ratio = 0; }},
       {"learned_boundary", [](core::ActParams& p) { p.learned_boundary = false; }},
       {"lattice_sampling", [](core::ActParams& p) { p.lattice_sampling = false; }},
+      {"pose_check", [](core::ActParams& p) { p.pose_check = false; }},
   };
   for (const auto& [name, apply] : off) {
     EvalMode m{"no_" + name, core::ActParams()};

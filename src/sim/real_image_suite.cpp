@@ -18,6 +18,7 @@ namespace sim {
 namespace {
 
 ToneCurve variantCurve(const std::string& name) {
+  if (name == "wrong_pose") return ToneCurve();  // the light stays; the pose changes
   if (name == "gain_0.5") return ToneCurve::gain(Eigen::Vector3d::Constant(0.5));
   if (name == "darken") return ToneCurve::brightnessContrast(0.5, 0.5);  // the paper's darkening
   if (name == "gamma_1.6") return ToneCurve::gamma(1.6);
@@ -50,7 +51,8 @@ std::vector<int> interiorPixels(const cv::Mat& expected, uint8_t k, int step) {
 }  // namespace
 
 const std::vector<std::string>& realImageVariants() {
-  static const std::vector<std::string> names = {"gain_0.5", "darken", "gamma_1.6", "warm_white_balance", "brighten"};
+  static const std::vector<std::string> names = {"gain_0.5",           "darken",   "gamma_1.6",
+                                                 "warm_white_balance", "brighten", "wrong_pose"};
   return names;
 }
 
@@ -75,6 +77,10 @@ RealImageResult evaluateRealImage(const RealImage& image,
   }
   core::Calibration cal = result.fit.calibration;
   const core::Pose2D pose = result.fit.pose;
+  // The paper's wrong pose (3.2): 2.5 m away, towards the field's centre along its length, and
+  // rotated by 165 degrees.
+  const core::Pose2D wrong_pose{pose.x_m + (pose.x_m >= 0 ? -2.5 : 2.5), pose.y_m,
+                                pose.theta_rad + 165.0 * M_PI / 180.0};
   cv::Mat rgb;
   cv::cvtColor(image.bgr, rgb, cv::COLOR_BGR2RGB);
   // The own robot's parts (item 3) from this one image: ACT's start-up table at the fitted pose,
@@ -173,7 +179,9 @@ RealImageResult evaluateRealImage(const RealImage& image,
           }
         }
         if (f == 0) trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles - 1);
-        const core::CycleStats stats = trainer.cycle(view, pose);
+        const bool pose_wrong =
+            variant == "wrong_pose" && f >= kRealFramesBefore && f < kRealFramesBefore + kRealWrongPoseFrames;
+        const core::CycleStats stats = trainer.cycle(view, pose_wrong ? wrong_pose : pose);
         const core::ColorLut& lut = trainer.lut();
         auto classOf = [&](int index) {
           const cv::Vec3b c = frame.at<cv::Vec3b>(index / frame.cols, index % frame.cols);

@@ -370,6 +370,75 @@ TEST_F(ActTrainerTest, SameSeedSameTable) {
   EXPECT_NE(a.lut().table(), c.lut().table());
 }
 
+// Self-localization lost (the paper's 2.5 m and 165 degrees off): the frame's samples land in
+// other classes of the table, and the frame trains nothing, until so many frames in a row
+// disagree that the table, not the pose, is taken to be wrong.
+TEST_F(ActTrainerTest, AFrameWhosePoseTheTableContradictsTrainsNothing) {
+  const auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  const Pose2D wrong{pose.x_m + 2.5 * std::cos(2.0), pose.y_m + 2.5 * std::sin(2.0),
+                     pose.theta_rad + 165.0 * M_PI / 180};
+  for (const bool check : {true, false}) {
+    SCOPED_TRACE(check ? "pose_check" : "no pose_check");
+    ActParams p;
+    p.pose_check = check;
+    ActTrainer trainer(cal, p);
+    trainer.bootstrap(view(frame.rgb), pose, kDefaultBootstrapCycles);
+    CycleStats s = trainer.cycle(view(frame.rgb), pose);  // a right pose: trained
+    EXPECT_FALSE(s.pose_contradicted);
+    EXPECT_LT(s.contradiction, kPoseContradiction);
+    const auto before = evaluate(trainer, frame, cal);
+    const std::vector<uint8_t> table = trainer.lut().table();
+    s = trainer.cycle(view(frame.rgb), wrong);
+    EXPECT_EQ(s.pose_contradicted, check);
+    const uint64_t revision = trainer.revision();
+    if (!check) {
+      EXPECT_NE(trainer.lut().table(), table);  // the wrong pose trained
+      continue;
+    }
+    EXPECT_GT(s.contradiction, kPoseContradiction);
+    EXPECT_EQ(s.added, (std::array<uint32_t, kNumClasses>{}));
+    for (int i = 2; i <= kMaxPoseRejections; ++i) {
+      ASSERT_TRUE(trainer.cycle(view(frame.rgb), wrong).pose_contradicted) << i;
+    }
+    EXPECT_EQ(trainer.lut().table(), table);
+    EXPECT_EQ(trainer.revision(), revision + kMaxPoseRejections - 1);  // a cycle each: the table's revision
+    const auto after = evaluate(trainer, frame, cal);
+    for (int k : {kGreen, kWhite, kYellow, kBlue}) EXPECT_EQ(after.recall(k), before.recall(k)) << className(k);
+    // As many frames in a row: the table is taken to be wrong and trains, until a frame agrees.
+    EXPECT_FALSE(trainer.cycle(view(frame.rgb), wrong).pose_contradicted);
+    EXPECT_NE(trainer.lut().table(), table);
+    EXPECT_FALSE(trainer.cycle(view(frame.rgb), wrong).pose_contradicted);
+    for (int i = 0; i < 5; ++i) trainer.cycle(view(frame.rgb), pose);
+    // Right again for long: a wrong pose is refused once more (the table was trained at the wrong
+    // pose for two frames only).
+    for (int i = 0; i < 20; ++i) trainer.cycle(view(frame.rgb), pose);
+    EXPECT_TRUE(trainer.cycle(view(frame.rgb), wrong).pose_contradicted);
+  }
+}
+
+// Nothing is refused before the table has had its start-up training, nor in the cycles of a change
+// of light (its colors move across classes before the table follows).
+TEST_F(ActTrainerTest, ThePoseIsCheckedOnlyAgainstATrainedTable) {
+  const auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  const Pose2D wrong{pose.x_m + 2.5 * std::cos(2.0), pose.y_m + 2.5 * std::sin(2.0),
+                     pose.theta_rad + 165.0 * M_PI / 180};
+  ActTrainer trainer(cal);
+  trainer.bootstrap(view(frame.rgb), pose, 30);
+  for (int i = 0; i < 10; ++i) EXPECT_FALSE(trainer.cycle(view(frame.rgb), wrong).pose_contradicted) << i;
+  ActTrainer loaded(cal);
+  loaded.loadTable(trainer.lut());  // a table from elsewhere: not yet confirmed on this camera
+  EXPECT_FALSE(loaded.cycle(view(frame.rgb), wrong).pose_contradicted);
+  ActTrainer lit(cal);
+  lit.bootstrap(view(frame.rgb), pose, kDefaultBootstrapCycles);
+  const auto dark = paintFlatFrame(model, pose, 0.5, 2);
+  ASSERT_TRUE(lit.cycle(view(dark.rgb), pose).light_change);
+  for (int i = 0; i < kPoseCheckQuietCycles; ++i) {
+    const CycleStats s = lit.cycle(view(dark.rgb), wrong);
+    EXPECT_GT(s.contradiction, kPoseContradiction) << i;  // the wrong pose shows
+    EXPECT_FALSE(s.pose_contradicted) << i;
+  }
+}
+
 // A saved state (table, clusters, revision) comes back as it was: training goes on from it, not
 // from eq. 2-3; a cluster that is none is refused.
 TEST_F(ActTrainerTest, ARestoredStateGoesOnWhereItStopped) {

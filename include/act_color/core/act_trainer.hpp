@@ -85,6 +85,13 @@ struct ActParams {
   // whose samples spread over the whole image (pixel_lattice.hpp): every 400th pixel of an 800 px
   // wide image lies in two of its columns, and a frame's samples then miss whatever lies between.
   bool lattice_sampling = true;
+  // A frame whose pose the table contradicts trains nothing (2.2-2.4 and the ball are skipped):
+  // when far more of its cluster samples than usual (expected green, white or a goal, the classes
+  // the pose decides) have a color the table gives to another of these classes, the pose is more
+  // likely wrong than the table (kPoseContradiction and those after it). Checked once the start-up
+  // training is done, not in the cycles of a change of light; after kMaxPoseRejections frames in a
+  // row the table is taken to be the one at fault and trains again until a frame agrees with it.
+  bool pose_check = true;
   // Beyond the paper, which leaves the ball out (2.1): the ball's color is learned from its shape.
   // Compact blobs on the carpet of the image size a sphere of ball_diameter_m has at their
   // distance, surrounded by carpet and of a color no trained class has, are ball candidates; a
@@ -122,6 +129,8 @@ struct CycleStats {
   Eigen::Vector3f light_gain{1.f, 1.f, 1.f};            // its per-channel gain at the carpet's color
   bool light_restored = false;                          // a change back to a light seen before: its table restored
   bool ball_seeded = false;                             // the ball's cluster was (re)seeded
+  bool pose_contradicted = false;                       // the table contradicts the pose: no training (pose_check)
+  float contradiction = 0.f;                            // the share of cluster samples the table gives another class
   // The ball as seen in this image (ActParams::ball_training), under the table before 2.4.
   struct Ball {
     bool seen = false;
@@ -143,6 +152,20 @@ constexpr int kBallSeedFrames = 6;
 constexpr int kBallSeedPlaces = 2;
 constexpr double kBallPlaceSpacingM = 0.3;
 constexpr double kBallSeedMaxMeanExtent = 1.5;
+
+// ActParams::pose_check. A frame is refused when the share of its samples that contradict the table
+// is above kPoseContradiction and above kPoseContradictionRatio times its running level over the
+// frames that trained (exponential, rate kPoseLevelRate): on the simulator's scenes, with the pose
+// 2.5 m and 165 deg off (the paper's wrong pose, act_eval's tuning split) 5-14% contradict, with a
+// right pose 0.5% (median; 1% of the frames above 4.4%), but on a real camera whose calibration is
+// a fit a right pose has 2-7% (act_real_eval, nubot_1_bak_bak). A change of light moves colors
+// across classes before the table follows: the kPoseCheckQuietCycles cycles after one are not
+// refused. The family's wrong poses last 8-40 frames.
+constexpr double kPoseContradiction = 0.05;
+constexpr double kPoseContradictionRatio = 3.0;
+constexpr double kPoseLevelRate = 0.1;
+constexpr int kPoseCheckQuietCycles = 3;
+constexpr int kMaxPoseRejections = 30;
 
 // The ACT algorithm (paper, section 2): one cycle per image and pose.
 class ActTrainer {
@@ -311,6 +334,16 @@ class ActTrainer {
   std::unordered_map<int, int> sampling_strides_;
   int add_weight_ = 1;              // pixels one in-field sample stands for in this cycle
   uint64_t last_light_change_ = 0;  // revision_ + 1 of the last change of light; 0: none
+  // pose_check: true when this cycle is not to train (stats: contradiction, pose_contradicted).
+  bool poseContradicted(CycleStats& stats);
+  // The share of this cycle's cluster samples of green, white and the goals whose color the table
+  // gives to another of them.
+  double poseContradiction() const;
+  bool bootstrapping_ = false;
+  uint64_t pose_check_from_ = kDefaultBootstrapCycles;  // a table trained for its start-up cycles
+  double pose_contradiction_level_ = -1;                // of the frames that trained; -1: none yet
+  int pose_rejections_ = 0;                             // frames rejected in a row
+  bool pose_released_ = false;                          // kMaxPoseRejections reached: no rejection until a frame agrees
   // This cycle adds at light_change_add_stride (a change of light's cycle or one of the
   // kDenseAddCycles - 1 after it); its additions fill their cells' neighbourhoods only in the
   // change's own cycle.

@@ -41,6 +41,9 @@ struct RealImage {
 
 constexpr int kRealFramesBefore = 20;
 constexpr int kRealFramesAfter = 40;
+// "wrong_pose": the image stays, ACT is told the paper's wrong pose in the first frames of the
+// change (then the right one again).
+constexpr int kRealWrongPoseFrames = 10;
 
 // Per frame, under the table after the frame's cycle.
 struct RealFrameFigures {
@@ -92,7 +95,8 @@ struct RealImageResult {
   std::vector<RealVariantResult> rows;
 };
 
-// The named variants, in order: "gain_0.5", "darken", "gamma_1.6", "warm_white_balance", "brighten".
+// The named variants, in order: "gain_0.5", "darken", "gamma_1.6", "warm_white_balance", "brighten",
+// "wrong_pose".
 const std::vector<std::string>& realImageVariants();
 
 // Runs the suite on one image for each mode (name, ACT parameters).
