@@ -76,14 +76,14 @@ class Operability : public ::testing::Test {
     frame_ = act_color::sim::paintFlatFrame(*model_, pose_, 1.0, 3);
   }
 
-  // Sends frames at ~20 Hz (pose first when `with_pose`, stamped `offset_s` from now) until `done`
-  // holds (checked under the waiter's mutex) or `timeout_s` passed.
+  // Sends frames at ~20 Hz (pose first when `with_pose`: `told`, else the right one; stamped
+  // `offset_s` from now) until `done` holds (checked under the waiter's mutex) or `timeout_s` passed.
   bool sendUntil(const cv::Mat& image, bool with_pose, double timeout_s, const std::function<bool()>& done,
-                 double offset_s = 0.0) {
+                 double offset_s = 0.0, const core::Pose2D* told = nullptr) {
     const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout_s);
     while (ros::WallTime::now() < end) {
       const ros::Time t = ros::Time::now() + ros::Duration(offset_s);
-      if (with_pose) pose_pub_.publish(makePose(pose_, t));
+      if (with_pose) pose_pub_.publish(makePose(told ? *told : pose_, t));
       image_pub_.publish(makeImage(image, "rgb8", t));
       last_sent_ = t;
       if (waiter_.waitFor(0.05, done)) return true;
@@ -166,6 +166,19 @@ TEST_F(Operability, DiagnosticsReconfigureSaveLoadTimeJump) {
     EXPECT_LT(cycle_max_ms, startup_ms);
     EXPECT_GE(value(trainer, "trained (%, last 5 s)"), 90.0);
   }
+
+  // 3b. Self-localization lost (the paper's 2.5 m and 165 degrees off): the table contradicts the
+  // pose, those frames train nothing, and the diagnostics and the log say so (~pose_check) ...
+  const core::Pose2D wrong{pose_.x_m + 2.5, pose_.y_m, pose_.theta_rad + 165.0 * M_PI / 180.0};
+  EXPECT_TRUE(sendUntil(
+      frame_.rgb, true, 15.0,
+      [&] { return statusIs(trainer, DiagnosticStatus::WARN, "the pose contradicted the color table"); }, 0.0, &wrong))
+      << describe(trainer);
+  EXPECT_TRUE(
+      waiter_.waitFor(5.0, [&] { return countLogs(rosgraph_msgs::Log::WARN, "contradict the color table") > 0; }));
+  // ... until it is right again.
+  EXPECT_TRUE(sendUntil(frame_.rgb, true, 20.0, [&] { return statusIs(trainer, DiagnosticStatus::OK, "training"); }))
+      << describe(trainer);
 
   // 4. dynamic_reconfigure: out of range is refused with the value as typed, the old value stays.
   auto reconfigure = [&](const std::string& node, const std::string& name, double v) {
