@@ -74,6 +74,10 @@ struct RealVariantResult {
   // (core::RecallCost; white -1 without hand-picked pixels). The same in every mode.
   double table_hall_as_white_before = -1, table_hall_as_white_after = -1;
   double table_hall_as_green_before = -1, table_hall_as_green_after = -1;
+  // The same at the first mode's own white and green recalls before and after, on its rows only
+  // (-1 elsewhere): the least hall any fixed table shows at what that mode reached.
+  double table_hall_as_white_at_mode_before = -1, table_hall_as_white_at_mode_after = -1;
+  double table_hall_as_green_at_mode_before = -1, table_hall_as_green_at_mode_after = -1;
 };
 
 struct RealImageResult {
