@@ -272,7 +272,7 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
           trainer.bootstrap(view, pose->pose, std::max(0, options.bootstrap_cycles - 1));
           bootstrapped = true;
         }
-        trainer.cycle(view, pose->pose);
+        result.pose_contradicted += trainer.cycle(view, pose->pose).pose_contradicted;
         ++result.trained;
         if (self_mask) self_mask->add(view, pose->pose, trainer.lut());
       } else {

@@ -139,6 +139,10 @@ int main(int argc, char** argv) {
     std::cout << "act_replay: " << result.images << " frames from " << options.input_bag << " (" << result.trained
               << " trained, " << result.without_pose << " without a usable pose, " << result.unusable_images
               << " unusable images, " << result.with_truth << " with truth); wrote " << options.output_bag << "\n";
+    if (result.pose_contradicted > 0) {
+      std::cout << "act_replay: " << result.pose_contradicted << " of the " << result.trained
+                << " trained frames trained nothing: the table contradicted their pose (pose_check)\n";
+    }
     if (result.truth_left_out > 0) {
       const size_t bad_image = result.truth_left_out - result.unusable_truth;
       std::cout << "act_replay: warning: " << result.truth_left_out << " of "

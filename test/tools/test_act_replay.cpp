@@ -170,6 +170,10 @@ TEST(ActReplay, ReachesTheAccuracyOfIssueThreeAfterDarkening) {
 TEST(ActReplay, AWrongPoseDoesNotSpoilTheTable) {
   std::ostringstream log;
   const auto result = runReplay(options(scenarioBag("wrong_pose"), tempDir() + "/wrong.bag"), log);
+  // Every third frame from frame 2 is told the wrong pose: those are refused (pose_check), the
+  // others train.
+  EXPECT_GE(result.pose_contradicted, 6u);
+  EXPECT_LE(result.pose_contradicted, 10u);
   const auto adapted = result.evaluation.adapted();
   EXPECT_GE(adapted.recall(act_color::core::kGreen), 0.95);
   EXPECT_GE(adapted.recall(act_color::core::kWhite), 0.90);

@@ -40,6 +40,7 @@ struct ReplayResult {
   size_t images = 0;
   size_t trained = 0;             // frames with a usable pose
   size_t without_pose = 0;        // frames before the first pose, or with a NaN pose
+  size_t pose_contradicted = 0;   // of the trained: the table contradicted the pose, nothing trained (pose_check)
   size_t unusable_images = 0;     // encoding, size, step or data unfit: labelled all unknown, left out of the metrics
   size_t with_truth = 0;          // frames in the metrics (a usable image and a usable truth image)
   size_t unusable_truth = 0;      // truth images that do not fit their image (encoding, size, step, data)
