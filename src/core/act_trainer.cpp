@@ -272,10 +272,7 @@ void ActTrainer::reset(ColorSpace space) {
   dark_frozen_ = false;
   light_states_.clear();
   last_light_change_ = 0;
-  pose_check_from_ = revision_ + kDefaultBootstrapCycles;
-  pose_rejections_ = 0;
-  pose_released_ = false;
-  pose_contradiction_level_ = -1;
+  restartPoseCheck();
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
   boundary_line_.fill(0.f);
@@ -319,10 +316,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   dark_frozen_ = false;
   light_states_.clear();
   last_light_change_ = 0;
-  pose_check_from_ = revision_ + kDefaultBootstrapCycles;  // a table from elsewhere: not yet confirmed here
-  pose_rejections_ = 0;
-  pose_released_ = false;
-  pose_contradiction_level_ = -1;
+  restartPoseCheck();  // a table from elsewhere: not yet confirmed here
   space_known_ = true;
 }
 
@@ -344,7 +338,7 @@ void ActTrainer::restore(const ColorLut& lut, const std::vector<SavedCluster>& c
     if (counts[c.class_id] > 0) clusters_[c.class_id].set(c.mean, c.sigma, true);
   }
   revision_ = revision;
-  pose_check_from_ = revision_ + kDefaultBootstrapCycles;  // loadTable's, from the restored revision
+  restartPoseCheck();  // loadTable's, from the restored revision
 }
 
 ClusterParams ActTrainer::clusterParams() const {
@@ -1276,6 +1270,13 @@ const ActTrainer::RemovalSamples& ActTrainer::removalSamples(size_t start) {
   return it->second;
 }
 
+void ActTrainer::restartPoseCheck() {
+  pose_check_from_ = revision_ + kDefaultBootstrapCycles;
+  pose_rejections_ = 0;
+  pose_released_ = false;
+  pose_contradiction_level_ = -1;
+}
+
 bool ActTrainer::poseContradicted(CycleStats& stats) {
   if (!params_.pose_check || bootstrapping_ || revision_ < pose_check_from_) return false;
   const double contradiction = poseContradiction();
@@ -1304,7 +1305,7 @@ double ActTrainer::poseContradiction() const {
   for (int k = kGreen; k <= kBlue; ++k) {
     for (const Eigen::Vector3f& c : samples_[k]) {
       const uint8_t t =
-          lut_.at(lut_.index(static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]), static_cast<uint8_t>(c[2])));
+          lut_.classOf(static_cast<uint8_t>(c[0]), static_cast<uint8_t>(c[1]), static_cast<uint8_t>(c[2]));
       contradicting += t != k && t >= kGreen && t <= kBlue;
     }
     total += samples_[k].size();
@@ -1320,6 +1321,8 @@ void ActTrainer::bootstrap(const ImageView& image, const Pose2D& pose, int cycle
     const bool value;
     ~Restore() { flag = value; }
   } restore{params_.ball_training, params_.ball_training};
+  // No pose check in the start-up training (its first cycle may start the table afresh, and with it
+  // the check's count of cycles).
   struct Bootstrapping {
     bool& flag;
     ~Bootstrapping() { flag = false; }

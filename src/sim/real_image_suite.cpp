@@ -11,6 +11,7 @@
 #include "act_color/core/segmenter.hpp"
 #include "act_color/core/self_mask_learner.hpp"
 #include "act_color/core/table_ceiling.hpp"
+#include "act_color/sim/scenario.hpp"
 #include "act_color/sim/tone_curve.hpp"
 
 namespace act_color {
@@ -79,8 +80,8 @@ RealImageResult evaluateRealImage(const RealImage& image,
   const core::Pose2D pose = result.fit.pose;
   // The paper's wrong pose (3.2): 2.5 m away, towards the field's centre along its length, and
   // rotated by 165 degrees.
-  const core::Pose2D wrong_pose{pose.x_m + (pose.x_m >= 0 ? -2.5 : 2.5), pose.y_m,
-                                pose.theta_rad + 165.0 * M_PI / 180.0};
+  const core::Pose2D wrong_pose{pose.x_m + (pose.x_m >= 0 ? -kWrongPoseDistanceM : kWrongPoseDistanceM), pose.y_m,
+                                pose.theta_rad + kWrongPoseRotationRad};
   cv::Mat rgb;
   cv::cvtColor(image.bgr, rgb, cv::COLOR_BGR2RGB);
   // The own robot's parts (item 3) from this one image: ACT's start-up table at the fitted pose,
@@ -352,6 +353,25 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
            "before / after |\n|---|---|---|---|---|---|\n";
     for (size_t n = 0; n < r.rows.size(); ++n) {
       const RealVariantResult& row = r.rows[n];
+      // A row of any fixed table's least hall at the white and green recalls given (before, after):
+      // each class's least share of the hall; their sum bounds the hall in a field class from below
+      // (a cell holds one class). Without hand-picked white pixels (white share -1) green alone.
+      using Pair = std::pair<double, double>;
+      auto boundRow = [&](const std::string& label, Pair white_recall, Pair green_recall, Pair white_hall,
+                          Pair green_hall) {
+        const bool with_white = white_hall.first >= 0;
+        char parts[96] = "least; green", white_col[48] = "-";
+        if (with_white) {
+          std::snprintf(parts, sizeof(parts), "least; white %.2f / %.2f, green %.2f / %.2f", white_hall.first,
+                        white_hall.second, green_hall.first, green_hall.second);
+          std::snprintf(white_col, sizeof(white_col), "%.2f / %.2f", white_recall.first, white_recall.second);
+        }
+        std::snprintf(line, sizeof(line), "| %s | %s | %s | - | %.2f / %.2f | %.2f / %.2f (%s) |\n",
+                      row.variant.c_str(), label.c_str(), white_col, green_recall.first, green_recall.second,
+                      green_hall.first + std::max(0.0, white_hall.first),
+                      green_hall.second + std::max(0.0, white_hall.second), parts);
+        out << line;
+      };
       char white[64], back[32];
       if (row.before.white_recall < 0) {
         std::snprintf(white, sizeof(white), "-");
@@ -376,43 +396,20 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
         out << line;
       }
       if (last_of_variant && row.table_hall_as_green_before >= 0) {
-        // Each class's least share of the hall at its target recall; their sum bounds the hall in a
-        // field class from below (a cell holds one class).
-        const bool white = row.table_hall_as_white_before >= 0;
-        const double before = row.table_hall_as_green_before + std::max(0.0, row.table_hall_as_white_before);
-        const double after = row.table_hall_as_green_after + std::max(0.0, row.table_hall_as_white_after);
-        char parts[96] = "least; green", white_target[32] = "-";
-        if (white) {
-          std::snprintf(parts, sizeof(parts), "least; white %.2f / %.2f, green %.2f / %.2f",
-                        row.table_hall_as_white_before, row.table_hall_as_white_after, row.table_hall_as_green_before,
-                        row.table_hall_as_green_after);
-          std::snprintf(white_target, sizeof(white_target), "%.2f / %.2f", kTargetWhiteRecall, kTargetWhiteRecall);
-        }
-        std::snprintf(line, sizeof(line), "| %s | any fixed table | %s | - | %.2f / %.2f | %.2f / %.2f (%s) |\n",
-                      row.variant.c_str(), white_target, kTargetGreenRecall, kTargetGreenRecall, before, after, parts);
-        out << line;
+        boundRow("any fixed table", {kTargetWhiteRecall, kTargetWhiteRecall}, {kTargetGreenRecall, kTargetGreenRecall},
+                 {row.table_hall_as_white_before, row.table_hall_as_white_after},
+                 {row.table_hall_as_green_before, row.table_hall_as_green_after});
       }
       // The same bound at the first mode's own recalls: how much of its hall figure a fixed table
       // could avoid without losing white or green.
       const RealVariantResult* first = &row;
       while (first != r.rows.data() && (first - 1)->variant == row.variant) --first;
       if (last_of_variant && first->table_hall_as_green_at_mode_before >= 0) {
-        const double before =
-            first->table_hall_as_green_at_mode_before + std::max(0.0, first->table_hall_as_white_at_mode_before);
-        const double after =
-            first->table_hall_as_green_at_mode_after + std::max(0.0, first->table_hall_as_white_at_mode_after);
-        char white[48] = "-", parts[96] = "least; green";
-        if (first->table_hall_as_white_at_mode_before >= 0) {
-          std::snprintf(white, sizeof(white), "%.2f / %.2f", first->before.white_recall, first->after.white_recall);
-          std::snprintf(parts, sizeof(parts), "least; white %.2f / %.2f, green %.2f / %.2f",
-                        first->table_hall_as_white_at_mode_before, first->table_hall_as_white_at_mode_after,
-                        first->table_hall_as_green_at_mode_before, first->table_hall_as_green_at_mode_after);
-        }
-        std::snprintf(line, sizeof(line),
-                      "| %s | any fixed table at the recalls of %s | %s | - | %.2f / %.2f | %.2f / %.2f (%s) |\n",
-                      row.variant.c_str(), first->mode.c_str(), white, first->before.green_recall,
-                      first->after.green_recall, before, after, parts);
-        out << line;
+        boundRow("any fixed table at the recalls of " + first->mode,
+                 {first->before.white_recall, first->after.white_recall},
+                 {first->before.green_recall, first->after.green_recall},
+                 {first->table_hall_as_white_at_mode_before, first->table_hall_as_white_at_mode_after},
+                 {first->table_hall_as_green_at_mode_before, first->table_hall_as_green_at_mode_after});
       }
     }
     out << "\n";

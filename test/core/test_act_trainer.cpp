@@ -8,6 +8,7 @@
 #include "act_color/core/pixel_lattice.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/sim/flat_painter.hpp"
+#include "act_color/sim/scenario.hpp"
 #include "test_util.hpp"
 
 using namespace act_color::core;
@@ -39,6 +40,12 @@ class ActTrainerTest : public ::testing::Test {
   Calibration cal = act_color::test::defaultCalibration();
   ExpectedClassModel model{cal};
   Pose2D pose{2.0, 1.0, 0.4};
+  // The paper's wrong pose (3.3): 2.5 m from `pose`, rotated by 165 degrees.
+  Pose2D wrongPose() const {
+    using act_color::sim::kWrongPoseDistanceM;
+    return {pose.x_m + kWrongPoseDistanceM * std::cos(2.0), pose.y_m + kWrongPoseDistanceM * std::sin(2.0),
+            pose.theta_rad + act_color::sim::kWrongPoseRotationRad};
+  }
 };
 
 }  // namespace
@@ -375,8 +382,7 @@ TEST_F(ActTrainerTest, SameSeedSameTable) {
 // disagree that the table, not the pose, is taken to be wrong.
 TEST_F(ActTrainerTest, AFrameWhosePoseTheTableContradictsTrainsNothing) {
   const auto frame = paintFlatFrame(model, pose, 1.0, 1);
-  const Pose2D wrong{pose.x_m + 2.5 * std::cos(2.0), pose.y_m + 2.5 * std::sin(2.0),
-                     pose.theta_rad + 165.0 * M_PI / 180};
+  const Pose2D wrong = wrongPose();
   for (const bool check : {true, false}) {
     SCOPED_TRACE(check ? "pose_check" : "no pose_check");
     ActParams p;
@@ -420,8 +426,7 @@ TEST_F(ActTrainerTest, AFrameWhosePoseTheTableContradictsTrainsNothing) {
 // of light (its colors move across classes before the table follows).
 TEST_F(ActTrainerTest, ThePoseIsCheckedOnlyAgainstATrainedTable) {
   const auto frame = paintFlatFrame(model, pose, 1.0, 1);
-  const Pose2D wrong{pose.x_m + 2.5 * std::cos(2.0), pose.y_m + 2.5 * std::sin(2.0),
-                     pose.theta_rad + 165.0 * M_PI / 180};
+  const Pose2D wrong = wrongPose();
   ActTrainer trainer(cal);
   trainer.bootstrap(view(frame.rgb), pose, 30);
   for (int i = 0; i < 10; ++i) EXPECT_FALSE(trainer.cycle(view(frame.rgb), wrong).pose_contradicted) << i;

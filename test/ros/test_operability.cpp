@@ -23,6 +23,7 @@
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/expected_class_model.hpp"
 #include "act_color/sim/flat_painter.hpp"
+#include "act_color/sim/scenario.hpp"
 #include "test_util.hpp"
 
 namespace {
@@ -169,7 +170,8 @@ TEST_F(Operability, DiagnosticsReconfigureSaveLoadTimeJump) {
 
   // 3b. Self-localization lost (the paper's 2.5 m and 165 degrees off): the table contradicts the
   // pose, those frames train nothing, and the diagnostics and the log say so (~pose_check) ...
-  const core::Pose2D wrong{pose_.x_m + 2.5, pose_.y_m, pose_.theta_rad + 165.0 * M_PI / 180.0};
+  const core::Pose2D wrong{pose_.x_m + act_color::sim::kWrongPoseDistanceM, pose_.y_m,
+                           pose_.theta_rad + act_color::sim::kWrongPoseRotationRad};
   EXPECT_TRUE(sendUntil(
       frame_.rgb, true, 15.0,
       [&] { return statusIs(trainer, DiagnosticStatus::WARN, "the pose contradicted the color table"); }, 0.0, &wrong))

@@ -339,6 +339,8 @@ class ActTrainer {
   // The share of this cycle's cluster samples of green, white and the goals whose color the table
   // gives to another of them.
   double poseContradiction() const;
+  // A new or loaded table: checked from kDefaultBootstrapCycles cycles on, never within bootstrap().
+  void restartPoseCheck();
   bool bootstrapping_ = false;
   uint64_t pose_check_from_ = kDefaultBootstrapCycles;  // a table trained for its start-up cycles
   double pose_contradiction_level_ = -1;                // of the frames that trained; -1: none yet
