@@ -24,8 +24,6 @@ constexpr double kHalfPi = kPi / 2;
 // Elevations are kept this far from the nadir (validateCalibration wants (-pi/2, pi/2)).
 constexpr double kMinElevation = -kHalfPi + 0.01;
 
-double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
-
 double median(std::vector<double> v) {
   if (v.empty()) return std::numeric_limits<double>::infinity();
   const auto mid = v.begin() + static_cast<long>(v.size() / 2);

@@ -80,8 +80,7 @@ RealImageResult evaluateRealImage(const RealImage& image,
   const core::Pose2D pose = result.fit.pose;
   // The paper's wrong pose (3.2): 2.5 m away, towards the field's centre along its length, and
   // rotated by 165 degrees.
-  const core::Pose2D wrong_pose{pose.x_m + (pose.x_m >= 0 ? -kWrongPoseDistanceM : kWrongPoseDistanceM), pose.y_m,
-                                pose.theta_rad + kWrongPoseRotationRad};
+  const core::Pose2D wrong_pose = wrongPose(pose, pose.x_m >= 0 ? M_PI : 0.0);
   cv::Mat rgb;
   cv::cvtColor(image.bgr, rgb, cv::COLOR_BGR2RGB);
   // The own robot's parts (item 3) from this one image: ACT's start-up table at the fitted pose,

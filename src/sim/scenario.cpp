@@ -14,7 +14,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinRobotDistanceM = 0.9;
 constexpr double kMinBallDistanceM = 0.5;
 
-double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+using core::wrapAngle;
 
 // Frame counts per length: (frames before the event, total).
 struct Counts {
@@ -93,9 +93,7 @@ Scenario wrongPose(ScenarioLength length, uint32_t seed) {
   const core::Pose2D a{-2.0, 0.5, 0.0};
   const core::Pose2D b{1.0, -1.5, 1.2};
   const double direction = 2.1;  // where the true pose lies, seen from B
-  const core::Pose2D c{b.x_m + kWrongPoseDistanceM * std::cos(direction),
-                       b.y_m + kWrongPoseDistanceM * std::sin(direction),
-                       wrapAngle(b.theta_rad + kWrongPoseRotationRad)};
+  const core::Pose2D c = sim::wrongPose(b, direction);
   const Ball ball{-0.5, -0.9, 0.11};
   for (int i = 0; i < total; ++i) {
     ScenarioFrame f;
@@ -203,6 +201,12 @@ Scenario spotlights(ScenarioLength length, const core::Calibration& cal, uint32_
 }
 
 }  // namespace
+
+core::Pose2D wrongPose(const core::Pose2D& from, double direction_rad) {
+  return {from.x_m + kWrongPoseDistanceM * std::cos(direction_rad),
+          from.y_m + kWrongPoseDistanceM * std::sin(direction_rad),
+          core::wrapAngle(from.theta_rad + kWrongPoseRotationRad)};
+}
 
 const std::vector<std::string>& scenarioNames() {
   static const std::vector<std::string> kNames = {"static_darkening", "wrong_pose", "driving", "spotlights",

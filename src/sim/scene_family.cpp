@@ -21,7 +21,7 @@ constexpr double kMinBallDistanceM = 0.5;
 constexpr int kSmallBefore = 14, kSmallAfter = 20;
 constexpr int kFullBefore = 42, kFullAfter = 40;
 
-double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+using core::wrapAngle;
 
 // The scene's random draws, all from one generator seeded with the scene's seed.
 class Draw {
@@ -668,8 +668,7 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length, bool ball_look
     const std::vector<core::Pose2D> window(truth.begin() + e.frame, truth.begin() + end);
     const double a = wrongPoseDirection(draw, window, field);
     for (int i = e.frame; i < end; ++i) {
-      told[i] = {truth[i].x_m + kWrongPoseDistanceM * std::cos(a), truth[i].y_m + kWrongPoseDistanceM * std::sin(a),
-                 wrapAngle(truth[i].theta_rad + kWrongPoseRotationRad)};
+      told[i] = wrongPose(truth[i], a);
     }
   }
 

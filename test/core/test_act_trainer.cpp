@@ -41,11 +41,7 @@ class ActTrainerTest : public ::testing::Test {
   ExpectedClassModel model{cal};
   Pose2D pose{2.0, 1.0, 0.4};
   // The paper's wrong pose (3.3): 2.5 m from `pose`, rotated by 165 degrees.
-  Pose2D wrongPose() const {
-    using act_color::sim::kWrongPoseDistanceM;
-    return {pose.x_m + kWrongPoseDistanceM * std::cos(2.0), pose.y_m + kWrongPoseDistanceM * std::sin(2.0),
-            pose.theta_rad + act_color::sim::kWrongPoseRotationRad};
-  }
+  Pose2D wrongPose() const { return act_color::sim::wrongPose(pose, 2.0); }
 };
 
 }  // namespace

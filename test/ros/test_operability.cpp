@@ -170,8 +170,7 @@ TEST_F(Operability, DiagnosticsReconfigureSaveLoadTimeJump) {
 
   // 3b. Self-localization lost (the paper's 2.5 m and 165 degrees off): the table contradicts the
   // pose, those frames train nothing, and the diagnostics and the log say so (~pose_check) ...
-  const core::Pose2D wrong{pose_.x_m + act_color::sim::kWrongPoseDistanceM, pose_.y_m,
-                           pose_.theta_rad + act_color::sim::kWrongPoseRotationRad};
+  const core::Pose2D wrong = act_color::sim::wrongPose(pose_, 0.0);
   EXPECT_TRUE(sendUntil(
       frame_.rgb, true, 15.0,
       [&] { return statusIs(trainer, DiagnosticStatus::WARN, "the pose contradicted the color table"); }, 0.0, &wrong))

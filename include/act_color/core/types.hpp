@@ -36,5 +36,8 @@ struct Pose2D {
   bool isFinite() const { return std::isfinite(x_m) && std::isfinite(y_m) && std::isfinite(theta_rad); }
 };
 
+// An angle in (-pi, pi].
+inline double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
+
 }  // namespace core
 }  // namespace act_color

@@ -51,6 +51,9 @@ bool parseScenarioLength(const std::string& text, ScenarioLength* length);
 // Parameters of the wrong-pose case (paper, 3.3).
 constexpr double kWrongPoseDistanceM = 2.5;
 constexpr double kWrongPoseRotationRad = 165.0 * 3.14159265358979323846 / 180.0;
+// The pose kWrongPoseDistanceM from `from` towards `direction_rad` (field frame), rotated by
+// kWrongPoseRotationRad.
+core::Pose2D wrongPose(const core::Pose2D& from, double direction_rad);
 
 }  // namespace sim
 }  // namespace act_color
