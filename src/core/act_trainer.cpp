@@ -104,28 +104,6 @@ struct StridedPixels {
   int du_, dv_;
 };
 
-// Pixels of the removal step by index, column and row. PackedPixels: rgb8 or bgr8 rows without
-// padding, where a pixel's bytes lie at 3 x its index; AnyPixels: every format and row step.
-template <bool kBgr>
-struct PackedPixels {
-  const uint8_t* data;
-  const uint8_t* address(uint32_t pixel, int, int) const { return data + 3 * static_cast<size_t>(pixel); }
-  void color(uint32_t pixel, int, int, uint8_t out[3]) const {
-    const uint8_t* p = address(pixel, 0, 0);
-    out[0] = p[kBgr ? 2 : 0];
-    out[1] = p[1];
-    out[2] = p[kBgr ? 0 : 2];
-  }
-};
-
-struct AnyPixels {
-  const ImageView& image;
-  const uint8_t* address(uint32_t, int u, int v) const {
-    return image.data + static_cast<size_t>(v) * image.step + static_cast<size_t>(u) * bytesPerPixel(image.format);
-  }
-  void color(uint32_t, int u, int v, uint8_t out[3]) const { image.color(u, v, out); }
-};
-
 }  // namespace
 
 void ActParams::validate() const {
@@ -973,13 +951,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
                          return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
                        }));
   }
-  if (packed_data && image.format == PixelFormat::kRgb8) {
-    removeOffField(PackedPixels<false>{image.data}, transform, stats);
-  } else if (packed_data && image.format == PixelFormat::kBgr8) {
-    removeOffField(PackedPixels<true>{image.data}, transform, stats);
-  } else {
-    removeOffField(AnyPixels{image}, transform, stats);
-  }
+  withPixels(image, [&](const auto& pixels) { removeOffField(pixels, transform, stats); });
   ++revision_;
   return stats;
 }

@@ -111,10 +111,17 @@ BallDetector::BallDetector(const ExpectedClassModel& model, double radius_m) : r
       const int u = std::min(gx * stride_ + stride_ / 2, camera.width() - 1);
       const int v = std::min(gy * stride_ + stride_ / 2, camera.height() - 1);
       const size_t pixel = static_cast<size_t>(v) * camera.width() + u;
-      if (camera.ray(pixel).region == PixelRegion::kAboveHorizon) beyond_.push_back(static_cast<uint32_t>(pixel));
+      GridPoint point{static_cast<uint32_t>(gy * grid_w_ + gx),
+                      static_cast<uint32_t>(pixel),
+                      0.f,
+                      static_cast<uint16_t>(u),
+                      static_cast<uint16_t>(v),
+                      kNoSector};
+      if (camera.ray(pixel).region == PixelRegion::kAboveHorizon) beyond_.push_back(point);
       if (camera.ray(pixel).region != PixelRegion::kFloor) continue;
-      points_.push_back({static_cast<uint32_t>(gy * grid_w_ + gx), static_cast<uint32_t>(pixel),
-                         model.removalRange(pixel), static_cast<uint8_t>(model.removalSector(pixel))});
+      point.range_m = model.removalRange(pixel);
+      point.sector = static_cast<uint8_t>(model.removalSector(pixel));
+      points_.push_back(point);
     }
   }
   grid_.assign(static_cast<size_t>(grid_w_) * grid_h_, kGridOff);
@@ -125,9 +132,13 @@ BallDetector::BallDetector(const ExpectedClassModel& model, double radius_m) : r
   window_.assign(model.pixels(), -1);
 }
 
-uint8_t BallDetector::classOf(const ColorLut& lut, const std::vector<KnownColor>& known_colors, const uint8_t c[3]) {
+inline uint8_t BallDetector::classOf(const ColorLut& lut, const std::vector<KnownColor>& known_colors,
+                                     const uint8_t c[3]) {
   const uint8_t k = lut.classOf(c[0], c[1], c[2]);
-  if (k != kUnknown) return k;
+  return k != kUnknown ? k : knownClassOf(known_colors, c);
+}
+
+uint8_t BallDetector::knownClassOf(const std::vector<KnownColor>& known_colors, const uint8_t c[3]) {
   const Eigen::Vector3f color(c[0], c[1], c[2]);
   const KnownColor* nearest = nullptr;
   float nearest_ratio = 1.f;  // squared distance over squared radius
@@ -153,16 +164,10 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
                           std::vector<uint32_t>* off_field_ball, uint32_t phase, bool look_off_field) {
   blobs->clear();
   off_field_ball->clear();
-  const int width = image.width;
+  const int width = image.width, height = image.height;
   // The look off the field moves within the grid's cells from cycle to cycle.
-  const int du = static_cast<int>(phase % stride_), dv = static_cast<int>((phase / stride_) % stride_);
-  auto shifted = [&](uint32_t pixel, uint32_t* out) {
-    const int u = static_cast<int>(pixel % width) - stride_ / 2 + du,
-              v = static_cast<int>(pixel / width) - stride_ / 2 + dv;
-    if (u < 0 || v < 0 || u >= width || v >= image.height) return false;
-    *out = static_cast<uint32_t>(v * width + u);
-    return true;
-  };
+  const int du = static_cast<int>(phase % stride_) - stride_ / 2,
+            dv = static_cast<int>((phase / stride_) % stride_) - stride_ / 2;
   auto tableClass = [&](uint32_t pixel) {
     uint8_t c[3];
     image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
@@ -170,26 +175,33 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
   };
   // The grid's classes (every floor point is written: last cycle's marks need no clearing).
   ball_points_.clear();
-  for (const GridPoint& p : points_) {
-    uint8_t g = kGridOff;
-    if (!ExpectedClassModel::mayBeOffField(p.range_m, safe[p.sector])) {
+  withPixels(image, [&](const auto& pixels) {
+    // A grid point's pixel of this cycle's look off the field, if it is one of the ball's class.
+    auto lookOffField = [&](const GridPoint& p) {
+      const int u = p.u + du, v = p.v + dv;
+      if (u < 0 || v < 0 || u >= width || v >= height) return;
+      const uint32_t q = static_cast<uint32_t>(v * width + u);
       uint8_t c[3];
-      image.color(static_cast<int>(p.pixel % width), static_cast<int>(p.pixel / width), c);
-      const uint8_t k = classOf(lut, known, c);
-      g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
-      if (g == kGridBall) ball_points_.push_back(p.cell);
-    } else if (look_off_field) {
-      uint32_t q;
-      if (shifted(p.pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
+      pixels.color(q, u, v, c);
+      if (lut.classOf(c[0], c[1], c[2]) == kOrange) off_field_ball->push_back(q);
+    };
+    for (const GridPoint& p : points_) {
+      uint8_t g = kGridOff;
+      if (!ExpectedClassModel::mayBeOffField(p.range_m, safe[p.sector])) {
+        uint8_t c[3];
+        pixels.color(p.pixel, p.u, p.v, c);
+        const uint8_t k = classOf(lut, known, c);
+        g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
+        if (g == kGridBall) ball_points_.push_back(p.cell);
+      } else if (look_off_field) {
+        lookOffField(p);
+      }
+      grid_[p.cell] = g;
     }
-    grid_[p.cell] = g;
-  }
-  if (look_off_field) {
-    for (const uint32_t pixel : beyond_) {
-      uint32_t q;
-      if (shifted(pixel, &q) && tableClass(q) == kOrange) off_field_ball->push_back(q);
+    if (look_off_field) {
+      for (const GridPoint& p : beyond_) lookOffField(p);
     }
-  }
+  });
   // Connected components of ball grid points (8-neighbourhood), the largest first.
   components_.clear();
   component_.clear();
@@ -299,16 +311,17 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
   const double seed_spread = std::sqrt(seed_sq / std::max<size_t>(1, seeds.size() - 1));
   const double grow_radius = std::max(kGrowMinRadius, kGrowSpreads * seed_spread);
   // window_: -1 not looked at, 0 looked at and not in the blob, 1 in the blob.
-  auto look = [&](uint32_t pixel) {
+  const double grow_radius_sq = grow_radius * grow_radius;
+  auto look = [&](uint32_t pixel, int u, int v) {
     int8_t& mark = window_[pixel];
     if (mark >= 0) return false;
     mark = 0;
     if (!onCarpet(model, sectors_, pixel, safe, reach_)) return false;
     uint8_t c[3];
-    image.color(static_cast<int>(pixel % width), static_cast<int>(pixel / width), c);
+    image.color(u, v, c);
     const uint8_t k = classOf(lut, known, c);
     if (!ballCandidate(k)) return false;
-    if ((Eigen::Vector3d(c[0], c[1], c[2]) - seed_mean).norm() > grow_radius) return false;
+    if ((Eigen::Vector3d(c[0], c[1], c[2]) - seed_mean).squaredNorm() > grow_radius_sq) return false;
     mark = 1;
     if (k == kOrange) ++blob->ball_pixels;
     return true;
@@ -316,7 +329,7 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
   looked_.clear();
   pixel_stack_.clear();
   for (const uint32_t s : seeds) {
-    if (look(s)) pixel_stack_.push_back(s);
+    if (look(s, static_cast<int>(s % width), static_cast<int>(s / width))) pixel_stack_.push_back(s);
     looked_.push_back(s);
   }
   while (!pixel_stack_.empty()) {
@@ -331,7 +344,7 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
       const uint32_t q = static_cast<uint32_t>(y * width + x);
       if (window_[q] >= 0) continue;
       looked_.push_back(q);
-      if (look(q)) pixel_stack_.push_back(q);
+      if (look(q, x, y)) pixel_stack_.push_back(q);
     }
   }
   blob->pixels = static_cast<uint32_t>(blob->members.size());

@@ -104,6 +104,8 @@ class BallDetector {
   // The pixel's class for the blobs: the table's, or for unknown colors that a known class's
   // cluster includes, that class.
   static uint8_t classOf(const ColorLut& lut, const std::vector<KnownColor>& known, const uint8_t c[3]);
+  // classOf for a color the table does not know.
+  static uint8_t knownClassOf(const std::vector<KnownColor>& known, const uint8_t c[3]);
 
   double radius_m_;
   int stride_ = 3;
@@ -114,10 +116,11 @@ class BallDetector {
     uint32_t cell;   // index in the grid
     uint32_t pixel;  // index in the image
     float range_m;
+    uint16_t u, v;  // the pixel's column and row
     uint8_t sector;
   };
   std::vector<GridPoint> points_;  // the grid's floor pixels
-  std::vector<uint32_t> beyond_;   // the grid's pixels above the horizon
+  std::vector<GridPoint> beyond_;  // the grid's pixels above the horizon (range and sector unused)
   std::vector<uint8_t> sectors_;   // every pixel's removal sector (ExpectedClassModel), 255 off the floor
   // Per-cycle scratch.
   std::vector<uint8_t> grid_;

@@ -69,6 +69,42 @@ struct ImageView {
   }
 };
 
+// Pixels by index, column and row, for loops over many pixels of one image. PackedPixels: rgb8 or
+// bgr8 rows without padding, where a pixel's bytes lie at 3 x its index; AnyPixels: every format
+// and row step. withPixels calls fn with the one that fits the image: the layout is decided once
+// per loop, not at every pixel.
+template <bool kBgr>
+struct PackedPixels {
+  const uint8_t* data;
+  const uint8_t* address(uint32_t pixel, int, int) const { return data + 3 * static_cast<size_t>(pixel); }
+  void color(uint32_t pixel, int, int, uint8_t out[3]) const {
+    const uint8_t* p = address(pixel, 0, 0);
+    out[0] = p[kBgr ? 2 : 0];
+    out[1] = p[1];
+    out[2] = p[kBgr ? 0 : 2];
+  }
+};
+
+struct AnyPixels {
+  const ImageView& image;
+  const uint8_t* address(uint32_t, int u, int v) const {
+    return image.data + static_cast<size_t>(v) * image.step + static_cast<size_t>(u) * bytesPerPixel(image.format);
+  }
+  void color(uint32_t, int u, int v, uint8_t out[3]) const { image.color(u, v, out); }
+};
+
+template <class Fn>
+void withPixels(const ImageView& image, Fn&& fn) {
+  const bool packed = image.step == bytesPerPixel(image.format) * static_cast<size_t>(image.width);
+  if (packed && image.format == PixelFormat::kRgb8) {
+    fn(PackedPixels<false>{image.data});
+  } else if (packed && image.format == PixelFormat::kBgr8) {
+    fn(PackedPixels<true>{image.data});
+  } else {
+    fn(AnyPixels{image});
+  }
+}
+
 // Converts an rgb8 image (CV_8UC3) to UYVY (CV_8UC2), BT.601 full range; for tests and the
 // simulator's yuv422 output.
 cv::Mat rgbToUyvy(const cv::Mat& rgb);
