@@ -2,7 +2,7 @@
 # The ACT cycle of this checkout against another revision's, measured in one run: builds REV
 # (default: the last commit before issue 11's work, eece390) in its own workspace, then runs both
 # act_benchmark binaries in turn (580x580, one core, three rounds) and prints the medians and
-# their ratio (issue 11: at most 1.3x).
+# their ratio (issue 11: at most 1.3x), also for this checkout without issue 13's ball stage.
 #   scripts/benchmark_against.sh [REV] [--rounds N]
 set -eo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
@@ -33,17 +33,24 @@ fi
 base="$base_ws/devel/lib/act_color/act_benchmark"
 cpu=$(( $(nproc) - 1 ))
 echo "act_color: ACT cycle at 580x580, $rev vs this checkout, $rounds rounds (load $(cut -d' ' -f1-3 /proc/loadavg))"
-declare -a b o
+declare -a b o n
 for _ in $(seq "$rounds"); do
   b+=("$("$base" --no-ros --sizes 580x580 --samples 15 --cpu "$cpu" | awk '$2 == "act_cycle" {print $3}')")
-  o+=("$("$ours" --no-ros --sizes 580x580 --samples 15 --cpu "$cpu" | awk '$2 == "act_cycle" {print $3}')")
+  run=$("$ours" --no-ros --sizes 580x580 --samples 15 --cpu "$cpu")
+  o+=("$(awk '$2 == "act_cycle" {print $3}' <<<"$run")")
+  n+=("$(awk '$2 == "act_cycle_no_ball" {print $3}' <<<"$run")")
 done
 median() { printf '%s\n' "$@" | sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
 mb=$(median "${b[@]}")
 mo=$(median "${o[@]}")
+mn=$(median "${n[@]}")
 echo "  $rev: ${b[*]} ms (median $mb)"
 echo "  this checkout: ${o[*]} ms (median $mo)"
 awk -v b="$mb" -v o="$mo" 'BEGIN {printf "  ratio (this / %s): %.2fx\n", "'"$rev"'", o / b}'
+if [ -n "$mn" ]; then
+  echo "  this checkout without the ball stage: ${n[*]} ms (median $mn)"
+  awk -v b="$mb" -v o="$mn" 'BEGIN {printf "  ratio (this without the ball stage / %s): %.2fx\n", "'"$rev"'", o / b}'
+fi
 # Instructions per ACT cycle under callgrind: repeatable whatever else the machine does.
 if command -v valgrind >/dev/null; then
   cycles=200
@@ -56,7 +63,13 @@ if command -v valgrind >/dev/null; then
     rm -f "$out"
     eval "ins_$which=$((total / cycles))"
   done
+  # And this checkout without issue 13's ball stage, which came after issue 11's budget was set.
+  out=$(mktemp)
+  valgrind --tool=callgrind --callgrind-out-file="$out" --collect-atstart=no \
+    --toggle-collect='*runCallgrindCycles*' "$ours" --callgrind-cycles "$cycles" --no-ball >/dev/null 2>&1
+  ins_no_ball=$(($(awk '/^summary:|^totals:/ {print $2; exit}' "$out") / cycles))
+  rm -f "$out"
   # shellcheck disable=SC2154
-  awk -v b="$ins_base" -v o="$ins_ours" -v r="$rev" \
-    'BEGIN {printf "  callgrind: %d instructions per cycle (%s), %d (this checkout): %.3fx\n", b, r, o, o / b}'
+  awk -v b="$ins_base" -v o="$ins_ours" -v n="$ins_no_ball" -v r="$rev" \
+    'BEGIN {printf "  callgrind: %d instructions per cycle (%s), %d (this checkout): %.3fx; without the ball stage %d: %.3fx\n", b, r, o, o / b, n, n / b}'
 fi

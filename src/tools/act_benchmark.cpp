@@ -40,6 +40,7 @@
 
 namespace {
 
+using act_color::core::ActParams;
 using act_color::core::ActTrainer;
 using act_color::core::Calibration;
 using act_color::core::ImageView;
@@ -217,6 +218,15 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
     const Frame& f = frames[i++ % frames.size()];
     cycling.cycle(view(f), f.pose);
   });
+  // The same without issue 13's ball stage (ActParams::ball_training false): what it costs.
+  ActTrainer cycling_no_ball = trainer;
+  ActParams no_ball = trainer.params();
+  no_ball.ball_training = false;
+  cycling_no_ball.setParams(no_ball);
+  add("act_cycle_no_ball", [&] {
+    const Frame& f = frames[i++ % frames.size()];
+    cycling_no_ball.cycle(view(f), f.pose);
+  });
   cv::Mat labels, labels_b;
   add("classify", [&] { segmenter.classify(trainer.lut(), view(frames[i++ % frames.size()]), labels); });
   add("classify_unmasked", [&] { unmasked.classify(trainer.lut(), view(frames[i++ % frames.size()]), labels); });
@@ -292,7 +302,7 @@ __attribute__((noinline)) void runCallgrindCycles(ActTrainer& trainer, const std
 void usage(std::ostream& out) {
   out << "usage: act_benchmark [--calibration CAL.yaml] [--json FILE] [--sizes 580x580,640x480,1280x1024]\n"
          "                     [--samples N (31)] [--sample-ms MS (20)] [--cpu N] [--no-ros]\n"
-         "       act_benchmark [--calibration CAL.yaml] --callgrind-cycles N\n";
+         "       act_benchmark [--calibration CAL.yaml] --callgrind-cycles N [--no-ball]\n";
 }
 
 }  // namespace
@@ -301,6 +311,7 @@ int main(int argc, char** argv) {
   std::string calibration_path = std::string(ACT_SOURCE_DIR) + "/config/calibration/msl_2007_580.yaml";
   std::string json_path, sizes_arg = "580x580,640x480,1280x1024";
   int samples = 31, cpu = -1, callgrind_cycles = 0;
+  bool ball_stage = true;
   double sample_ms = 20.0;
   bool use_ros = true;
   try {
@@ -324,6 +335,8 @@ int main(int argc, char** argv) {
         cpu = std::stoi(value());
       } else if (arg == "--callgrind-cycles") {
         callgrind_cycles = std::stoi(value());
+      } else if (arg == "--no-ball") {
+        ball_stage = false;
       } else if (arg == "--no-ros") {
         use_ros = false;
       } else if (arg == "--help" || arg == "-h") {
@@ -352,6 +365,11 @@ int main(int argc, char** argv) {
     ActTrainer trainer(base);
     trainer.bootstrap(view(frames[0]), frames[0].pose, core::kDefaultBootstrapCycles);
     for (const Frame& f : frames) trainer.cycle(view(f), f.pose);
+    if (!ball_stage) {
+      ActParams params = trainer.params();
+      params.ball_training = false;
+      trainer.setParams(params);
+    }
     runCallgrindCycles(trainer, frames, callgrind_cycles);
     std::cout << "act_benchmark: " << callgrind_cycles << " ACT cycles on "
               << sizeName(base.camera.width, base.camera.height) << " frames in runCallgrindCycles\n";
@@ -424,6 +442,11 @@ int main(int argc, char** argv) {
     out << "\ntargets (580x580, one core)\n" << std::setprecision(4);
     out << "  ACT cycle median " << cycle->median_ms
         << " ms <= 0.1 ms: " << (cycle->median_ms <= 0.1 ? "met" : "MISSED") << "\n";
+    if (const auto* no_ball = find(*r580, "act_cycle_no_ball")) {
+      out << "  (without the ball stage " << no_ball->median_ms << " ms: the stage takes " << std::setprecision(0)
+          << 100.0 * (1.0 - no_ball->median_ms / cycle->median_ms) << "% of the cycle)\n"
+          << std::setprecision(4);
+    }
     out << "  classification " << std::setprecision(2) << cls->pixels_per_s() / 1e9
         << " Gpixel/s >= 1: " << (cls->pixels_per_s() >= 1e9 ? "met" : "MISSED") << "; "
         << ratio(*r580, "inrange_per_class", "classify")
