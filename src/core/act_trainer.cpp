@@ -782,6 +782,75 @@ void ActTrainer::checkImage(const ImageView& image) const {
     throw std::invalid_argument("yuv422 needs an even width");
 }
 
+void ActTrainer::measureChassis(const ImageView& image) {
+  // The own chassis's median intensity: the black of this light (robots_train_black).
+  chassis_intensity_ = 0;
+  if (chassis_pixels_.empty()) return;
+  const int width = image.width;
+  std::vector<double>& values = chassis_intensities_;
+  values.clear();
+  for (const uint32_t i : chassis_pixels_) {
+    uint8_t c[3];
+    image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
+    values.push_back(c[0] + c[1] + c[2]);
+  }
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  chassis_intensity_ = values[values.size() / 2];
+  const double green = clusters_[kGreen].mean().sum();
+  if (!dark_frozen_ && clusters_[kGreen].trained() && green - chassis_intensity_ >= kMinAnchorSpan) {
+    dark_position_ = (kDarkFraction * green - chassis_intensity_) / (green - chassis_intensity_);
+  }
+}
+
+template <class LookCloser>
+void ActTrainer::followLight(const ImageView& image, LookCloser&& look_closer, CycleStats& stats) {
+  // The anchors of the light model (before any class filters its colors): carpet and lines from
+  // the cluster samples, the chassis densely. The carpet as the pose expects it, before
+  // robots_train_black: the paper's darkening takes the carpet below 60% of green's intensity,
+  // where all of it would train black, and the change went unseen for 4 frames (tuning seed 20).
+  const int width = image.width;
+  for (const uint32_t i : chassis_pixels_) {
+    uint8_t c[3];
+    image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
+    chassis_samples_.emplace_back(c[0], c[1], c[2]);
+  }
+  light_.observe(carpet_samples_, samples_[kWhite], chassis_samples_);
+  const ClassCluster& green = clusters_[kGreen];
+  auto lightMoved = [&] {
+    return (light_.greenMedian() - light_.referenceGreenMedian()).norm() >
+           std::max(kLightChangeSigmas * green.sigma(), kLightChangeMinShift);
+  };
+  bool light_changed = green.trained() && light_.hasReference() && light_.observedGreen() && lightMoved();
+  if (light_changed) {
+    look_closer();
+    light_.observe(anchor_samples_[kGreen], anchor_samples_[kWhite], chassis_samples_);
+    light_changed = light_.observedGreen() && lightMoved();
+  }
+  LightModel::Map light_map;
+  if (light_changed && restoreLightState()) {
+    light_changed = false;
+    stats.light_restored = true;
+    dark_frozen_ = true;
+  } else if (light_changed) {
+    light_changed = light_.estimate(lut_.colorSpace(), &light_map);
+  }
+  if (!light_changed) {
+    light_.follow(params_.eta);
+    return;
+  }
+  keepLightState();
+  const Eigen::Vector3d from = light_.referenceGreenMedian();
+  const Eigen::Vector3d pivot = LightModel::pivot(lut_.colorSpace());
+  for (int c = 0; c < 3; ++c) {
+    const double d = from[c] - pivot[c];
+    stats.light_gain[c] = static_cast<float>(std::abs(d) > 1e-6 ? (light_map.at(c, from[c]) - pivot[c]) / d : 1.0);
+  }
+  applyLightChange(light_map);
+  light_.rebase(light_map);
+  stats.light_change = true;
+  dark_frozen_ = true;
+}
+
 CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   checkImage(image);
   if (!pose.isFinite()) throw std::invalid_argument("pose is not finite");
@@ -822,23 +891,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     }
   };
 
-  // The own chassis's median intensity: the black of this light (robots_train_black).
-  chassis_intensity_ = 0;
-  if (!chassis_pixels_.empty()) {
-    std::vector<double>& values = chassis_intensities_;
-    values.clear();
-    for (const uint32_t i : chassis_pixels_) {
-      uint8_t c[3];
-      image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
-      values.push_back(c[0] + c[1] + c[2]);
-    }
-    std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-    chassis_intensity_ = values[values.size() / 2];
-    const double green = clusters_[kGreen].mean().sum();
-    if (!dark_frozen_ && clusters_[kGreen].trained() && green - chassis_intensity_ >= kMinAnchorSpan) {
-      dark_position_ = (kDarkFraction * green - chassis_intensity_) / (green - chassis_intensity_);
-    }
-  }
+  measureChassis(image);
 
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
@@ -852,63 +905,24 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     if (expected_k == kGreen && params_.light_compensation) carpet_samples_.emplace_back(c[0], c[1], c[2]);
     samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
   });
-  // The anchors of the light model (before any class filters its colors): carpet and lines from
-  // the cluster samples, the chassis densely. The carpet as the pose expects it, before
-  // robots_train_black: the paper's darkening takes the carpet below 60% of green's intensity,
-  // where all of it would train black, and the change went unseen for 4 frames (tuning seed 20).
   if (params_.light_compensation) {
-    for (const uint32_t i : chassis_pixels_) {
-      uint8_t c[3];
-      image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
-      chassis_samples_.emplace_back(c[0], c[1], c[2]);
-    }
-    light_.observe(carpet_samples_, samples_[kWhite], chassis_samples_);
-  }
-  const ClusterParams cluster_params = clusterParams();
-  const ClassCluster& green = clusters_[kGreen];
-  LightModel::Map light_map;
-  auto lightMoved = [&] {
-    return (light_.greenMedian() - light_.referenceGreenMedian()).norm() >
-           std::max(kLightChangeSigmas * green.sigma(), kLightChangeMinShift);
-  };
-  bool light_changed =
-      params_.light_compensation && green.trained() && light_.hasReference() && light_.observedGreen() && lightMoved();
-  if (light_changed) {
     // A closer look before the whole table moves: carpet and lines of this frame at the stride of
     // the change cycle's additions.
-    for (auto& a : anchor_samples_) a.clear();
-    everyNth(std::min(params_.cluster_stride, params_.light_change_add_stride), [&](const StridedPixels& p) {
-      const uint8_t k = expected(p);
-      if (k != kGreen && k != kWhite) return;
-      uint8_t c[3];
-      image.color(p.u, p.v, c);
-      anchor_samples_[k].emplace_back(c[0], c[1], c[2]);
-    });
-    light_.observe(anchor_samples_[kGreen], anchor_samples_[kWhite], chassis_samples_);
-    light_changed = light_.observedGreen() && lightMoved();
+    followLight(
+        image,
+        [&] {
+          for (auto& a : anchor_samples_) a.clear();
+          everyNth(std::min(params_.cluster_stride, params_.light_change_add_stride), [&](const StridedPixels& p) {
+            const uint8_t k = expected(p);
+            if (k != kGreen && k != kWhite) return;
+            uint8_t c[3];
+            image.color(p.u, p.v, c);
+            anchor_samples_[k].emplace_back(c[0], c[1], c[2]);
+          });
+        },
+        stats);
   }
-  if (light_changed && restoreLightState()) {
-    light_changed = false;
-    stats.light_restored = true;
-    dark_frozen_ = true;
-  } else if (light_changed) {
-    light_changed = light_.estimate(lut_.colorSpace(), &light_map);
-  }
-  if (light_changed) {
-    keepLightState();
-    const Eigen::Vector3d from = light_.referenceGreenMedian();
-    const Eigen::Vector3d pivot = LightModel::pivot(lut_.colorSpace());
-    for (int c = 0; c < 3; ++c) {
-      const double d = from[c] - pivot[c];
-      stats.light_gain[c] = static_cast<float>(std::abs(d) > 1e-6 ? (light_map.at(c, from[c]) - pivot[c]) / d : 1.0);
-    }
-    applyLightChange(light_map);
-    light_.rebase(light_map);
-    stats.light_change = true;
-    dark_frozen_ = true;
-  } else if (params_.light_compensation) {
-    light_.follow(params_.eta);
-  }
+  const ClusterParams cluster_params = clusterParams();
   if (poseContradicted(stats)) {
     ++revision_;
     return stats;
@@ -939,18 +953,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   if (params_.ball_training) trainBall(image, transform, stats);
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
-  const size_t start = randomStart(samplingStride(params_.remove_stride));
-  const RemovalSamples& samples = removalSamples(start);
-  // The samples that may be off the field: in each sector of bearings, a prefix of its list.
-  candidates_.clear();
-  for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
-    const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
-    const auto first = samples.samples.begin() + samples.sector_begin[sector];
-    const auto last = samples.samples.begin() + samples.sector_begin[sector + 1];
-    candidates_.insert(candidates_.end(), first, std::partition_point(first, last, [&](const RemovalSample& sample) {
-                         return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
-                       }));
-  }
+  selectRemovalCandidates(randomStart(samplingStride(params_.remove_stride)));
   withPixels(image, [&](const auto& pixels) { removeOffField(pixels, transform, stats); });
   ++revision_;
   return stats;
@@ -1128,6 +1131,20 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
       train(b);
       break;
     }
+  }
+}
+
+void ActTrainer::selectRemovalCandidates(size_t start) {
+  const RemovalSamples& samples = removalSamples(start);
+  // The samples that may be off the field: in each sector of bearings, a prefix of its list.
+  candidates_.clear();
+  for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
+    const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
+    const auto first = samples.samples.begin() + samples.sector_begin[sector];
+    const auto last = samples.samples.begin() + samples.sector_begin[sector + 1];
+    candidates_.insert(candidates_.end(), first, std::partition_point(first, last, [&](const RemovalSample& sample) {
+                         return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
+                       }));
   }
 }
 

@@ -229,6 +229,13 @@ class ActTrainer {
   // ActParams::evidence_removal_ratio for color c of class k (lower for the ball, higher for a
   // clipped color).
   double evidenceRatio(uint8_t k, const uint8_t c[3]) const;
+  // robots_train_black's black of this light: the own chassis's median intensity.
+  void measureChassis(const ImageView& image);
+  // Light compensation (after 2.2's samples, before the clusters move): observes the anchors, and
+  // when the carpet's median moved, takes a closer look (`look_closer` fills anchor_samples_ with
+  // this frame's carpet and line colors) and restores a kept light or moves the table.
+  template <class LookCloser>
+  void followLight(const ImageView& image, LookCloser&& look_closer, CycleStats& stats);
   // Light compensation: the map moves every cluster and every table cell.
   void applyLightChange(const LightModel::Map& map);
   // Light that comes and goes (flicker, an exposure controller hunting, one dark frame in ten):
@@ -369,6 +376,8 @@ class ActTrainer {
   std::unordered_map<size_t, RemovalSamples> removal_samples_;
   std::array<double, ExpectedClassModel::kRemovalSectors> sector_safe_range_{};
   std::vector<RemovalSample> candidates_;  // scratch: this cycle's samples that may be off the field
+  // Fills candidates_ from the samples of `start` (sector_safe_range_ of the pose).
+  void selectRemovalCandidates(size_t start);
   // 2.4 on candidates_, reading their colors through `pixels` (see act_trainer.cpp).
   template <class Pixels>
   void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
