@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <type_traits>
 
 #include "act_color/core/color_lut.hpp"
+#include "act_color/core/image_view.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "test_util.hpp"
 
@@ -105,4 +108,44 @@ TEST(ImageView, YuvConversionOfGrey) {
   EXPECT_EQ(f, PixelFormat::kUyvy);
   EXPECT_FALSE(pixelFormatFromEncoding("mono8", &f));
   EXPECT_THROW(ImageView::fromMat(grey, PixelFormat::kUyvy), std::invalid_argument);
+}
+
+// withPixels picks the accessor that fits the layout; each reads what ImageView::color reads, at
+// every pixel (packed rgb8 and bgr8 at 3 x the index, padded rows and UYVY through the view).
+TEST(ImageView, WithPixelsReadsAsColorInEveryLayout) {
+  cv::Mat rgb(5, 8, CV_8UC3);
+  cv::randu(rgb, cv::Scalar::all(0), cv::Scalar::all(256));
+  cv::Mat padded_storage(5, 10, CV_8UC3, cv::Scalar::all(0));
+  rgb.copyTo(padded_storage(cv::Rect(0, 0, 8, 5)));
+  const cv::Mat padded = padded_storage(cv::Rect(0, 0, 8, 5));  // rows of 30 bytes, 24 used
+  const cv::Mat uyvy = rgbToUyvy(rgb);
+  struct Case {
+    ImageView view;
+    bool packed;
+  };
+  const Case cases[] = {{ImageView::fromMat(rgb, PixelFormat::kRgb8), true},
+                        {ImageView::fromMat(rgb, PixelFormat::kBgr8), true},
+                        {ImageView::fromMat(padded, PixelFormat::kRgb8), false},
+                        {ImageView::fromMat(uyvy, PixelFormat::kUyvy), false}};
+  for (const Case& c : cases) {
+    int calls = 0;
+    withPixels(c.view, [&](const auto& pixels) {
+      ++calls;
+      using Pixels = std::decay_t<decltype(pixels)>;
+      const bool packed = !std::is_same_v<Pixels, AnyPixels>;
+      EXPECT_EQ(packed, c.packed) << encodingName(c.view.format);
+      for (int v = 0; v < c.view.height; ++v) {
+        for (int u = 0; u < c.view.width; ++u) {
+          const uint32_t index = static_cast<uint32_t>(v * c.view.width + u);
+          uint8_t expected[3], got[3];
+          c.view.color(u, v, expected);
+          pixels.color(index, u, v, got);
+          for (int ch = 0; ch < 3; ++ch) ASSERT_EQ(got[ch], expected[ch]) << u << "," << v << " channel " << ch;
+          EXPECT_EQ(pixels.address(index, u, v), c.view.data + v * c.view.step + u * bytesPerPixel(c.view.format))
+              << encodingName(c.view.format);
+        }
+      }
+    });
+    EXPECT_EQ(calls, 1);
+  }
 }
