@@ -117,6 +117,7 @@ void ActParams::validate() const {
   requireRange("lut_bits", lut_bits, 1, 8);
   requireRange("add_neighbourhood_cells", add_neighbourhood_cells, 0, 3);
   requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
+  requireRange("robot_height_m", robot_height_m, 0.0, 5.0);
   requireRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
   requireRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
   requireRange("ball_diameter_m", ball_diameter_m, 0.05, 1.0);
@@ -171,6 +172,8 @@ void ActParams::set(const std::string& name, const std::string& value) {
     light_compensation = boolean();
   } else if (name == "light_change_add_stride") {
     light_change_add_stride = integer();
+  } else if (name == "robot_height_m") {
+    robot_height_m = number();
   } else if (name == "removal_protect_cycles") {
     removal_protect_cycles = integer();
   } else if (name == "robots_train_black") {
@@ -204,6 +207,7 @@ void ActParams::switchOffExtensions() {
   add_neighbourhood_cells = 0;
   light_compensation = false;
   removal_protect_cycles = 0;
+  robot_height_m = 0;
   robots_train_black = false;
   nearest_mean = false;
   evidence_removal_ratio = 0;
@@ -1136,16 +1140,51 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
 
 void ActTrainer::selectRemovalCandidates(size_t start) {
   const RemovalSamples& samples = removalSamples(start);
-  // The samples that may be off the field: in each sector of bearings, a prefix of its list.
+  removal_list_ = &samples;
+  const double h = model_.camera().viewpointHeight(), robot = params_.robot_height_m;
+  robot_reach_ = h > robot ? h / (h - robot) : std::numeric_limits<double>::infinity();
+  robot_sectors_.fill(kRobotUnknown);
+  // The samples that may be off the field: in each sector of bearings, a prefix of its list
+  // (farthest first); the rest lie on the carpet.
   candidates_.clear();
+  candidate_sectors_.clear();
   for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
     const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
     const auto first = samples.samples.begin() + samples.sector_begin[sector];
     const auto last = samples.samples.begin() + samples.sector_begin[sector + 1];
-    candidates_.insert(candidates_.end(), first, std::partition_point(first, last, [&](const RemovalSample& sample) {
-                         return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
-                       }));
+    const auto on_carpet = std::partition_point(first, last, [&](const RemovalSample& sample) {
+      return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
+    });
+    candidates_.insert(candidates_.end(), first, on_carpet);
+    candidate_sectors_.resize(candidates_.size(), static_cast<uint8_t>(sector));
+    const auto band_end = std::partition_point(
+        on_carpet, last, [&](const RemovalSample& sample) { return sample.range_m * robot_reach_ >= safe_range; });
+    robot_bands_[static_cast<size_t>(sector)] = {static_cast<uint32_t>(on_carpet - samples.samples.begin()),
+                                                 static_cast<uint32_t>(band_end - samples.samples.begin())};
   }
+}
+
+template <class Pixels>
+bool ActTrainer::maybeRobot(int sector, float range_m, const Pixels& pixels) {
+  if (!(params_.robot_height_m > 0) || !(range_m < robot_reach_ * sector_safe_range_[static_cast<size_t>(sector)])) {
+    return false;
+  }
+  constexpr int n = ExpectedClassModel::kRemovalSectors;
+  for (const int s : {sector, (sector + 1) % n, (sector + n - 1) % n}) {
+    uint8_t& state = robot_sectors_[static_cast<size_t>(s)];
+    if (state == kRobotUnknown) {
+      state = kNoRobot;
+      const auto [begin, end] = robot_bands_[static_cast<size_t>(s)];
+      for (uint32_t i = begin; i < end && state == kNoRobot; ++i) {
+        const RemovalSample& sample = removal_list_->samples[i];
+        uint8_t c[3];
+        pixels.color(sample.pixel, sample.u, sample.v, c);
+        if (lut_.classOf(c[0], c[1], c[2]) == kBlack) state = kRobot;
+      }
+    }
+    if (state == kRobot) return true;
+  }
+  return false;
 }
 
 template <class Pixels>
@@ -1176,6 +1215,7 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
     if (!mapped(cell)) continue;  // the bitmap fits the L1 cache, the table does not
     const uint8_t k = lut_.at(cell);
     if (k >= kNumClasses) continue;
+    if (k == kBlack && maybeRobot(candidate_sectors_[j], sample.range_m, pixels)) continue;
     if (!model_.offField(sample.pixel, transform)) continue;
     ++stats.remove_candidates;
     // The ball is one small object whose colors are never expected from the pose: one sighting off

@@ -232,6 +232,7 @@ bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) 
                     readParam(pnh_, "light_compensation", &p.light_compensation, error) &&
                     readParam(pnh_, "light_change_add_stride", &p.light_change_add_stride, error) &&
                     readParam(pnh_, "removal_protect_cycles", &p.removal_protect_cycles, error) &&
+                    readParam(pnh_, "robot_height_m", &p.robot_height_m, error) &&
                     readParam(pnh_, "robots_train_black", &p.robots_train_black, error) &&
                     readParam(pnh_, "nearest_mean", &p.nearest_mean, error) &&
                     readParam(pnh_, "evidence_removal_ratio", &p.evidence_removal_ratio, error) &&
@@ -452,6 +453,7 @@ ActTrainerConfig ActTrainerNodelet::configInEffect() const {
   c.light_compensation = p.light_compensation;
   c.light_change_add_stride = p.light_change_add_stride;
   c.removal_protect_cycles = p.removal_protect_cycles;
+  c.robot_height_m = p.robot_height_m;
   c.robots_train_black = p.robots_train_black;
   c.nearest_mean = p.nearest_mean;
   c.evidence_removal_ratio = p.evidence_removal_ratio;
@@ -482,6 +484,7 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
   p.light_compensation = c.light_compensation;
   p.light_change_add_stride = c.light_change_add_stride;
   p.removal_protect_cycles = c.removal_protect_cycles;
+  p.robot_height_m = c.robot_height_m;
   p.robots_train_black = c.robots_train_black;
   p.nearest_mean = c.nearest_mean;
   p.evidence_removal_ratio = c.evidence_removal_ratio;

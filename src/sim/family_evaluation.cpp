@@ -107,6 +107,7 @@ std::vector<EvalMode> evalModes(bool ablations) {
       {"add_neighbourhood_cells", [](core::ActParams& p) { p.add_neighbourhood_cells = 0; }},
       {"light_compensation", [](core::ActParams& p) { p.light_compensation = false; }},
       {"removal_protect_cycles", [](core::ActParams& p) { p.removal_protect_cycles = 0; }},
+      {"robot_height_m", [](core::ActParams& p) { p.robot_height_m = 0; }},
       {"robots_train_black", [](core::ActParams& p) { p.robots_train_black = false; }},
       {"nearest_mean", [](core::ActParams& p) { p.nearest_mean = false; }},
       {"evidence_removal_ratio", [](core::ActParams& p) { p.evidence_removal_ratio = 0; }},

@@ -54,6 +54,13 @@ struct ActParams {
   // cycles is not removed for being seen off the field: colors seen on both sides (a dark
   // poster like a robot) stay with the class that needs them. 0: the paper's removal.
   int removal_protect_cycles = 10;
+  // The other robots' height (m; MSL: at most 0.8). A robot standing on the carpet is imaged
+  // farther out than where it stands (its top at h / (h - H) times the floor range, h the camera's
+  // height; beyond the horizon when h <= H), so that a robot near the carpet's edge shows its colors
+  // where the pose expects the hall. In a sector of bearings where a removal sample on the carpet
+  // within that reach of the edge is black in the table, 2.4's samples within the reach do not
+  // count against black. 0: every off-field sample counts (the paper).
+  double robot_height_m = 0.8;
   // Black is the own chassis and the other robots, but the chassis alone is lit differently from
   // robots elsewhere on the field: a color expected green or a goal that is far from green (beyond
   // zeta * sigma), dark (intensity below 60% of green's in the light before the first change, a
@@ -375,9 +382,23 @@ class ActTrainer {
   const RemovalSamples& removalSamples(size_t start);
   std::unordered_map<size_t, RemovalSamples> removal_samples_;
   std::array<double, ExpectedClassModel::kRemovalSectors> sector_safe_range_{};
-  std::vector<RemovalSample> candidates_;  // scratch: this cycle's samples that may be off the field
+  std::vector<RemovalSample> candidates_;   // scratch: this cycle's samples that may be off the field
+  std::vector<uint8_t> candidate_sectors_;  // their sectors
   // Fills candidates_ from the samples of `start` (sector_safe_range_ of the pose).
   void selectRemovalCandidates(size_t start);
+  // ActParams::robot_height_m. A robot standing at floor range d is imaged out to d * robot_reach_
+  // (its top). Per sector, this cycle's samples on the carpet from safe range / robot_reach_ on (a
+  // robot there is imaged beyond the carpet's edge), in removal_list_; and whether one of them is
+  // black in the table, looked at when a black candidate first asks (kRobotUnknown before).
+  const RemovalSamples* removal_list_ = nullptr;
+  double robot_reach_ = 1.0;
+  std::array<std::pair<uint32_t, uint32_t>, ExpectedClassModel::kRemovalSectors> robot_bands_{};
+  std::array<uint8_t, ExpectedClassModel::kRemovalSectors> robot_sectors_{};
+  static constexpr uint8_t kRobotUnknown = 0, kNoRobot = 1, kRobot = 2;
+  // An off-field sample of `sector` at floor range `range_m` may show such a robot (of this sector
+  // or a neighbouring one: a robot at 5 m spans about a sector).
+  template <class Pixels>
+  bool maybeRobot(int sector, float range_m, const Pixels& pixels);
   // 2.4 on candidates_, reading their colors through `pixels` (see act_trainer.cpp).
   template <class Pixels>
   void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
