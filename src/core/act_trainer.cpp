@@ -1140,7 +1140,7 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
 
 void ActTrainer::selectRemovalCandidates(size_t start) {
   const RemovalSamples& samples = removalSamples(start);
-  removal_list_ = &samples;
+  removal_start_ = start;
   const double h = model_.camera().viewpointHeight(), robot = params_.robot_height_m;
   robot_reach_ = h > robot ? h / (h - robot) : std::numeric_limits<double>::infinity();
   robot_sectors_.fill(kRobotUnknown);
@@ -1175,8 +1175,9 @@ bool ActTrainer::maybeRobot(int sector, float range_m, const Pixels& pixels) {
     if (state == kRobotUnknown) {
       state = kNoRobot;
       const auto [begin, end] = robot_bands_[static_cast<size_t>(s)];
+      const std::vector<RemovalSample>& samples = removalSamples(removal_start_).samples;
       for (uint32_t i = begin; i < end && state == kNoRobot; ++i) {
-        const RemovalSample& sample = removal_list_->samples[i];
+        const RemovalSample& sample = samples[i];
         uint8_t c[3];
         pixels.color(sample.pixel, sample.u, sample.v, c);
         if (lut_.classOf(c[0], c[1], c[2]) == kBlack) state = kRobot;
