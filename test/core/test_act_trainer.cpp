@@ -829,7 +829,7 @@ TEST_F(ActTrainerTest, ARobotAtTheCarpetsEdgeKeepsItsColorThoughItIsImagedOverTh
       const int s = model.removalSector(i);
       if (std::abs(s - sector) > 3) continue;
       const double range = model.removalRange(i);
-      if (!(range >= 0.9 * edge)) continue;
+      if (!(range >= 0.75 * edge)) continue;
       frame.at<cv::Vec3b>(static_cast<int>(i / 580), static_cast<int>(i % 580)) = robot;
       ++(range < edge ? *on_carpet : *beyond);
     }
