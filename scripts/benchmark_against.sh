@@ -54,22 +54,21 @@ fi
 # Instructions per ACT cycle under callgrind: repeatable whatever else the machine does.
 if command -v valgrind >/dev/null; then
   cycles=200
-  for which in base ours; do
-    bin=$([ "$which" = base ] && echo "$base" || echo "$ours")
+  # Instructions per ACT cycle of BIN [ARGS...] under callgrind.
+  instructions() {
+    local bin=$1 out total
+    shift
     out=$(mktemp)
     valgrind --tool=callgrind --callgrind-out-file="$out" --collect-atstart=no \
-      --toggle-collect='*runCallgrindCycles*' "$bin" --callgrind-cycles "$cycles" >/dev/null 2>&1
+      --toggle-collect='*runCallgrindCycles*' "$bin" --callgrind-cycles "$cycles" "$@" >/dev/null 2>&1
     total=$(awk '/^summary:|^totals:/ {print $2; exit}' "$out")
     rm -f "$out"
-    eval "ins_$which=$((total / cycles))"
-  done
+    echo $((total / cycles))
+  }
+  ins_base=$(instructions "$base")
+  ins_ours=$(instructions "$ours")
   # And this checkout without issue 13's ball stage, which came after issue 11's budget was set.
-  out=$(mktemp)
-  valgrind --tool=callgrind --callgrind-out-file="$out" --collect-atstart=no \
-    --toggle-collect='*runCallgrindCycles*' "$ours" --callgrind-cycles "$cycles" --no-ball >/dev/null 2>&1
-  ins_no_ball=$(($(awk '/^summary:|^totals:/ {print $2; exit}' "$out") / cycles))
-  rm -f "$out"
-  # shellcheck disable=SC2154
+  ins_no_ball=$(instructions "$ours" --no-ball)
   awk -v b="$ins_base" -v o="$ins_ours" -v n="$ins_no_ball" -v r="$rev" \
     'BEGIN {printf "  callgrind: %d instructions per cycle (%s), %d (this checkout): %.3fx; without the ball stage %d: %.3fx\n", b, r, o, o / b, n, n / b}'
 fi

@@ -795,8 +795,10 @@ void ActTrainer::checkImage(const ImageView& image) const {
 }
 
 void ActTrainer::measureChassis(const ImageView& image) {
-  // The own chassis's median intensity: the black of this light (robots_train_black).
+  // The own chassis's colors (also an anchor of the light model) and their median intensity: the
+  // black of this light (robots_train_black).
   chassis_intensity_ = 0;
+  chassis_samples_.clear();
   if (chassis_pixels_.empty()) return;
   const int width = image.width;
   std::vector<double>& values = chassis_intensities_;
@@ -804,6 +806,7 @@ void ActTrainer::measureChassis(const ImageView& image) {
   for (const uint32_t i : chassis_pixels_) {
     uint8_t c[3];
     image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
+    chassis_samples_.emplace_back(c[0], c[1], c[2]);
     values.push_back(c[0] + c[1] + c[2]);
   }
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
@@ -815,17 +818,12 @@ void ActTrainer::measureChassis(const ImageView& image) {
 }
 
 template <class LookCloser>
-void ActTrainer::followLight(const ImageView& image, LookCloser&& look_closer, CycleStats& stats) {
+void ActTrainer::followLight(LookCloser&& look_closer, CycleStats& stats) {
   // The anchors of the light model (before any class filters its colors): carpet and lines from
   // the cluster samples, the chassis densely. The carpet as the pose expects it, before
   // robots_train_black: the paper's darkening takes the carpet below 60% of green's intensity,
   // where all of it would train black, and the change went unseen for 4 frames (tuning seed 20).
-  const int width = image.width;
-  for (const uint32_t i : chassis_pixels_) {
-    uint8_t c[3];
-    image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
-    chassis_samples_.emplace_back(c[0], c[1], c[2]);
-  }
+  // The chassis's colors are measureChassis's.
   light_.observe(carpet_samples_, samples_[kWhite], chassis_samples_);
   const ClassCluster& green = clusters_[kGreen];
   auto lightMoved = [&] {
@@ -890,7 +888,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   // lie far apart in memory: the ray and, in images without row padding, the color of the pixel
   // kSamplesAhead strides ahead are fetched.
   const size_t bytes_per_pixel = bytesPerPixel(image.format);
-  const uint8_t* packed_data = image.step == bytes_per_pixel * width ? image.data : nullptr;
+  const uint8_t* packed_data = packedRows(image) ? image.data : nullptr;
   auto everyNth = [&](int n, auto&& visit) {
     const int stride = samplingStride(n);
     const size_t ahead = static_cast<size_t>(kSamplesAhead) * stride;
@@ -907,7 +905,6 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
 
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
-  chassis_samples_.clear();
   carpet_samples_.clear();
   everyNth(params_.cluster_stride, [&](const StridedPixels& p) {
     const uint8_t expected_k = expected(p);
@@ -921,7 +918,6 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     // A closer look before the whole table moves: carpet and lines of this frame at the stride of
     // the change cycle's additions.
     followLight(
-        image,
         [&] {
           for (auto& a : anchor_samples_) a.clear();
           everyNth(std::min(params_.cluster_stride, params_.light_change_add_stride), [&](const StridedPixels& p) {

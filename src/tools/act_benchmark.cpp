@@ -182,6 +182,13 @@ struct SizeResult {
   std::map<std::string, double> agreement;  // fraction of pixels with the same label as Segmenter
 };
 
+// Issue 13's ball stage off (ActParams::ball_training), the rest as trained.
+void switchOffBallStage(ActTrainer& trainer) {
+  ActParams params = trainer.params();
+  params.ball_training = false;
+  trainer.setParams(params);
+}
+
 std::string sizeName(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
 bool ros_started = false;
@@ -220,9 +227,7 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
   });
   // The same without issue 13's ball stage (ActParams::ball_training false): what it costs.
   ActTrainer cycling_no_ball = trainer;
-  ActParams no_ball = trainer.params();
-  no_ball.ball_training = false;
-  cycling_no_ball.setParams(no_ball);
+  switchOffBallStage(cycling_no_ball);
   add("act_cycle_no_ball", [&] {
     const Frame& f = frames[i++ % frames.size()];
     cycling_no_ball.cycle(view(f), f.pose);
@@ -365,11 +370,7 @@ int main(int argc, char** argv) {
     ActTrainer trainer(base);
     trainer.bootstrap(view(frames[0]), frames[0].pose, core::kDefaultBootstrapCycles);
     for (const Frame& f : frames) trainer.cycle(view(f), f.pose);
-    if (!ball_stage) {
-      ActParams params = trainer.params();
-      params.ball_training = false;
-      trainer.setParams(params);
-    }
+    if (!ball_stage) switchOffBallStage(trainer);
     runCallgrindCycles(trainer, frames, callgrind_cycles);
     std::cout << "act_benchmark: " << callgrind_cycles << " ACT cycles on "
               << sizeName(base.camera.width, base.camera.height) << " frames in runCallgrindCycles\n";

@@ -236,13 +236,14 @@ class ActTrainer {
   // ActParams::evidence_removal_ratio for color c of class k (lower for the ball, higher for a
   // clipped color).
   double evidenceRatio(uint8_t k, const uint8_t c[3]) const;
-  // robots_train_black's black of this light: the own chassis's median intensity.
+  // The own chassis's colors (chassis_samples_, an anchor of the light model) and their median
+  // intensity, robots_train_black's black of this light.
   void measureChassis(const ImageView& image);
   // Light compensation (after 2.2's samples, before the clusters move): observes the anchors, and
   // when the carpet's median moved, takes a closer look (`look_closer` fills anchor_samples_ with
   // this frame's carpet and line colors) and restores a kept light or moves the table.
   template <class LookCloser>
-  void followLight(const ImageView& image, LookCloser&& look_closer, CycleStats& stats);
+  void followLight(LookCloser&& look_closer, CycleStats& stats);
   // Light compensation: the map moves every cluster and every table cell.
   void applyLightChange(const LightModel::Map& map);
   // Light that comes and goes (flicker, an exposure controller hunting, one dark frame in ten):

@@ -93,9 +93,14 @@ struct AnyPixels {
   void color(uint32_t, int u, int v, uint8_t out[3]) const { image.color(u, v, out); }
 };
 
+// Rows without padding: a pixel's bytes lie at bytesPerPixel x its index.
+inline bool packedRows(const ImageView& image) {
+  return image.step == bytesPerPixel(image.format) * static_cast<size_t>(image.width);
+}
+
 template <class Fn>
 void withPixels(const ImageView& image, Fn&& fn) {
-  const bool packed = image.step == bytesPerPixel(image.format) * static_cast<size_t>(image.width);
+  const bool packed = packedRows(image);
   if (packed && image.format == PixelFormat::kRgb8) {
     fn(PackedPixels<false>{image.data});
   } else if (packed && image.format == PixelFormat::kBgr8) {
