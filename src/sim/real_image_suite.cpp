@@ -157,6 +157,7 @@ RealImageResult evaluateRealImage(const RealImage& image,
       core::ActTrainer trainer(cal, params);
       cv::RNG rng(seed);
       std::vector<RealFrameFigures> figures;
+      cv::Mat frame_last, labels_last;
       for (int f = 0; f < kRealFramesBefore + kRealFramesAfter; ++f) {
         cv::Mat frame = (f < kRealFramesBefore ? rgb : changed).clone();
         cv::Mat noise(frame.size(), CV_16SC3);
@@ -193,14 +194,16 @@ RealImageResult evaluateRealImage(const RealImage& image,
           for (const cv::Point& p : whites) white += classOf(p.y * frame.cols + p.x) == core::kWhite;
           fig.white_recall = static_cast<double>(white) / whites.size();
         }
-        size_t green = 0, in_field = 0;
+        size_t green = 0, in_field = 0, black = 0;
         for (const int i : carpet) green += classOf(i) == core::kGreen;
         for (const int i : hall) {
           const uint8_t k = classOf(i);
           in_field += k == core::kGreen || k == core::kWhite;
+          black += k == core::kBlack;
         }
         fig.green_recall = carpet.empty() ? 0.0 : static_cast<double>(green) / carpet.size();
         fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
+        fig.hall_as_black = hall.empty() ? 0.0 : static_cast<double>(black) / hall.size();
         if (image.ball) {
           size_t inside = 0, inside_ball = 0, predicted = 0, predicted_near = 0;
           for (int i = 0; i < frame.rows * frame.cols; ++i) {
@@ -221,6 +224,10 @@ RealImageResult evaluateRealImage(const RealImage& image,
           fig.ball_seen = stats.ball.seen && image.ball->contains(stats.ball.u, stats.ball.v, 3.0) ? 1.0 : 0.0;
         }
         figures.push_back(fig);
+        if (first_mode && f == kRealFramesBefore + kRealFramesAfter - 1) {
+          frame_last = frame.clone();
+          core::Segmenter(cal.camera).classify(lut, view, labels_last);
+        }
         if (result.labels_before.empty() && f == kRealFramesBefore - 1) {
           result.frame_before = frame.clone();
           core::Segmenter(cal.camera).classify(lut, view, result.labels_before);
@@ -246,10 +253,12 @@ RealImageResult evaluateRealImage(const RealImage& image,
           m.white_recall += figures[f].white_recall;
           m.green_recall += figures[f].green_recall;
           m.hall_in_field += figures[f].hall_in_field;
+          m.hall_as_black += figures[f].hall_as_black;
         }
         m.white_recall /= count;
         m.green_recall /= count;
         m.hall_in_field /= count;
+        m.hall_as_black /= count;
         if (whites.empty()) m.white_recall = -1;
         if (image.ball) {
           // Precision over the frames with ball pixels.
@@ -283,6 +292,8 @@ RealImageResult evaluateRealImage(const RealImage& image,
         row.white_recovery_cycles = last_below == kRealFramesAfter - 1 ? -1 : cycles;
       }
       row.frames = figures;
+      row.frame_last = frame_last;
+      row.labels_last = labels_last;
       row.nubot_before = nubot_before;
       row.nubot_after = nubot_after;
       row.table_hall_as_white_before = white_before.leastUnwantedShare(kTargetWhiteRecall);
@@ -349,7 +360,7 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
       out << line;
     }
     out << "| variant | mode | white before / after | white back in | green before / after | hall in a field class "
-           "before / after |\n|---|---|---|---|---|---|\n";
+           "before / after | hall as black before / after |\n|---|---|---|---|---|---|---|\n";
     for (size_t n = 0; n < r.rows.size(); ++n) {
       const RealVariantResult& row = r.rows[n];
       // A row of any fixed table's least hall at the white and green recalls given (before, after):
@@ -365,7 +376,7 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
                         white_hall.second, green_hall.first, green_hall.second);
           std::snprintf(white_col, sizeof(white_col), "%.2f / %.2f", white_recall.first, white_recall.second);
         }
-        std::snprintf(line, sizeof(line), "| %s | %s | %s | - | %.2f / %.2f | %.2f / %.2f (%s) |\n",
+        std::snprintf(line, sizeof(line), "| %s | %s | %s | - | %.2f / %.2f | %.2f / %.2f (%s) | - |\n",
                       row.variant.c_str(), label.c_str(), white_col, green_recall.first, green_recall.second,
                       green_hall.first + std::max(0.0, white_hall.first),
                       green_hall.second + std::max(0.0, white_hall.second), parts);
@@ -383,13 +394,14 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
           std::snprintf(back, sizeof(back), "%d", row.white_recovery_cycles);
         }
       }
-      std::snprintf(line, sizeof(line), "| %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f |\n", row.variant.c_str(),
-                    row.mode.c_str(), white, back, row.before.green_recall, row.after.green_recall,
-                    row.before.hall_in_field, row.after.hall_in_field);
+      std::snprintf(line, sizeof(line), "| %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f |\n",
+                    row.variant.c_str(), row.mode.c_str(), white, back, row.before.green_recall, row.after.green_recall,
+                    row.before.hall_in_field, row.after.hall_in_field, row.before.hall_as_black,
+                    row.after.hall_as_black);
       out << line;
       const bool last_of_variant = n + 1 == r.rows.size() || r.rows[n + 1].variant != row.variant;
       if (last_of_variant && row.nubot_before.green_recall >= 0) {
-        std::snprintf(line, sizeof(line), "| %s | NuBot's table | - | - | %.2f / %.2f | %.2f / %.2f (green) |\n",
+        std::snprintf(line, sizeof(line), "| %s | NuBot's table | - | - | %.2f / %.2f | %.2f / %.2f (green) | - |\n",
                       row.variant.c_str(), row.nubot_before.green_recall, row.nubot_after.green_recall,
                       row.nubot_before.hall_in_field, row.nubot_after.hall_in_field);
         out << line;
@@ -455,6 +467,7 @@ std::string formatRealImageFrames(const std::vector<RealImageResult>& results) {
       series("white", row.frames, &RealFrameFigures::white_recall);
       series("green", row.frames, &RealFrameFigures::green_recall);
       series("hall ", row.frames, &RealFrameFigures::hall_in_field);
+      series("black", row.frames, &RealFrameFigures::hall_as_black);
     }
   }
   return out.str();

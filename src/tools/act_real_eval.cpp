@@ -27,10 +27,24 @@ void printUsage(std::ostream& out) {
          "                 and CTableBGR.dat (NuBot's hand-made table, compared with ACT's)\n"
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
          "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n"
-         "  --png DIR      each image beside its classes (defaults, the frame before the change) as a PNG\n"
+         "  --png DIR      each image beside its classes (defaults) as PNGs: the frame before the change\n"
+         "                 (NAME_classified.png) and the last frame of each variant (NAME_VARIANT.png)\n"
          "  --set NAME=VALUE  an ActParams parameter of the defaults (repeatable; e.g. seed=2)\n"
-         "  --frames       also every frame's white recall, green recall and hall in a field class (after\n"
-         "                 the change from frame 21), per variant and mode\n";
+         "  --frames       also every frame's white recall, green recall, hall in a field class and hall\n"
+         "                 as black (after the change from frame 21), per variant and mode\n";
+}
+
+// An rgb8 frame beside its labels in the palette, as one PNG; false (and a message) when it
+// cannot be written.
+bool writeClassified(const std::string& path, const cv::Mat& frame_rgb, const cv::Mat& labels) {
+  cv::Mat bgr, colored, out;
+  cv::cvtColor(frame_rgb, bgr, cv::COLOR_RGB2BGR);
+  act_color::core::colorizeLabels(labels, colored);
+  cv::cvtColor(colored, colored, cv::COLOR_RGB2BGR);
+  cv::hconcat(bgr, colored, out);
+  if (cv::imwrite(path, out)) return true;
+  std::cerr << "act_real_eval: " << path << ": cannot be written\n";
+  return false;
 }
 
 bool isFile(const std::string& path) {
@@ -123,18 +137,16 @@ int main(int argc, char** argv) {
     results.push_back(act_color::sim::evaluateRealImage(image, modes));
     const auto& r = results.back();
     if (!png_dir.empty() && !r.labels_before.empty()) {
-      cv::Mat bgr, colored, out;
-      cv::cvtColor(r.frame_before, bgr, cv::COLOR_RGB2BGR);
-      act_color::core::colorizeLabels(r.labels_before, colored);
-      cv::cvtColor(colored, colored, cv::COLOR_RGB2BGR);
-      cv::hconcat(bgr, colored, out);
-      std::string file = image.name;
-      std::replace(file.begin(), file.end(), '/', '_');
-      const std::string path = png_dir + "/" + file.substr(0, file.rfind('.')) + "_classified.png";
-      if (!cv::imwrite(path, out)) {
-        std::cerr << "act_real_eval: " << path << ": cannot be written\n";
-        return 1;
+      std::string stem = image.name;
+      std::replace(stem.begin(), stem.end(), '/', '_');
+      stem = png_dir + "/" + stem.substr(0, stem.rfind('.'));
+      bool written = writeClassified(stem + "_classified.png", r.frame_before, r.labels_before);
+      for (const auto& row : r.rows) {
+        if (!row.labels_last.empty()) {
+          written = written && writeClassified(stem + "_" + row.variant + ".png", row.frame_last, row.labels_last);
+        }
       }
+      if (!written) return 1;
     }
     std::cerr << "act_real_eval: " << image.name << " done\n";
   }

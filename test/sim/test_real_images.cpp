@@ -4,6 +4,7 @@
 // calibrator fits; README ("Real images") has every image and figure, the paper beside.
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
@@ -38,6 +39,13 @@ void expectHolds(const sim::RealImageResult& r) {
     EXPECT_GE(row.before.white_recall, 0.50) << row.variant;
     EXPECT_GE(row.before.green_recall, 0.88) << row.variant;
     EXPECT_LE(row.before.hall_in_field, 0.15) << row.variant;
+    // Nor does black take the hall (a robot's class, counted apart; measured 0.10 on nubot_1 and
+    // 0.03 on nubot_1_bak_bak).
+    EXPECT_LE(row.before.hall_as_black, 0.15) << row.variant;
+    // The look at the image after the change (act_real_eval --png): the last frame and its labels.
+    ASSERT_EQ(row.frame_last.size(), row.labels_last.size()) << row.variant;
+    ASSERT_EQ(row.labels_last.type(), CV_8UC1) << row.variant;
+    EXPECT_GT(cv::countNonZero(row.labels_last == core::kGreen), row.labels_last.total() / 10) << row.variant;
     // After it: white and green are not lost (the 0.50 for white).
     EXPECT_GE(row.after.white_recall, 0.50) << row.variant;
     EXPECT_GE(row.after.green_recall, 0.80) << row.variant;
@@ -65,7 +73,7 @@ TEST(RealImages, Nubot1) {
     }
     EXPECT_EQ(count, sim::kRealFramesBefore + sim::kRealFramesAfter) << line;
   }
-  EXPECT_EQ(series, 3 * static_cast<int>(r.rows.size()));
+  EXPECT_EQ(series, 4 * static_cast<int>(r.rows.size()));
   // The least share of the hall any fixed table classifies white while half the hand-picked line
   // pixels are white, and green while 88% of the carpet is (core::RecallCost; measured white 0.01
   // before each change, 0.18 after the 1.5x brightening, whose saturated line cores share a cell

@@ -50,6 +50,7 @@ struct RealFrameFigures {
   double white_recall = -1;  // of the hand-picked line pixels classified white (-1: none given)
   double green_recall = 0;   // of the pixels expected carpet inside the outer lines, 3 px from other classes
   double hall_in_field = 0;  // of the pixels expected off the carpet (3 px from it) classified green or white
+  double hall_as_black = 0;  // of the same pixels, classified black (a robot's class: not counted above)
   // With a marked ball (-1 without): of the pixels 2 px inside the mark, the fraction classified as the
   // ball; of the pixels classified as the ball, the fraction within 3 px of the mark (-1: none); 1 when
   // the trainer reported the ball (CycleStats::ball) with its blob's centroid within 3 px of the mark.
@@ -65,6 +66,10 @@ struct RealVariantResult {
   // or no hand-picked pixels).
   int white_recovery_cycles = -1;
   std::vector<RealFrameFigures> frames;  // every frame's figures
+  // The first mode's labels of the sequence's last frame, and that frame (rgb8); empty in the other
+  // modes' rows: a look at the image classified after the change.
+  cv::Mat frame_last;
+  cv::Mat labels_last;
   // NuBot's fixed table on the image and on the changed image (white_recall unused; -1: no table).
   RealFrameFigures nubot_before{-1, -1, -1};
   RealFrameFigures nubot_after{-1, -1, -1};
