@@ -17,6 +17,7 @@
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/mirror_calibrator.hpp"
 #include "act_color/sim/calibrator_check.hpp"
+#include "cli_numbers.hpp"
 #include "seed_range.hpp"
 
 namespace {
@@ -56,23 +57,8 @@ int usage(const std::string& message) {
   return 2;
 }
 
-std::vector<double> numbers(const std::string& text, size_t count, const std::string& option) {
-  std::vector<double> out;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    char* end = nullptr;
-    const double v = std::strtod(item.c_str(), &end);
-    if (item.empty() || *end != '\0' || !std::isfinite(v)) throw std::invalid_argument(option + ": '" + text + "'");
-    out.push_back(v);
-  }
-  if (out.size() != count) {
-    throw std::invalid_argument(option + " needs " + std::to_string(count) + " comma-separated numbers");
-  }
-  return out;
-}
-
-double number(const std::string& text, const std::string& option) { return numbers(text, 1, option)[0]; }
+using act_color_tools::parseNumber;
+using act_color_tools::parseNumbers;
 
 void printResidual(const std::string& what, const core::LineResidual& r) {
   std::printf(
@@ -123,36 +109,36 @@ int main(int argc, char** argv) {
       } else if (arg == "--preset") {
         preset = value();
       } else if (arg == "--pose") {
-        const auto p = numbers(value(), 3, arg);
+        const auto p = parseNumbers(value(), 3, arg);
         options.pose = {p[0], p[1], p[2]};
       } else if (arg == "--height-m") {
-        options.height_m = number(value(), arg);
+        options.height_m = parseNumber(value(), arg);
         if (!(options.height_m > 0)) throw std::invalid_argument("--height-m must be positive");
       } else if (arg == "--center") {
-        const auto p = numbers(value(), 2, arg);
+        const auto p = parseNumbers(value(), 2, arg);
         options.center_px = Eigen::Vector2d(p[0], p[1]);
       } else if (arg == "--mirror-radius") {
-        options.mirror_radius_px = number(value(), arg);
+        options.mirror_radius_px = parseNumber(value(), arg);
       } else if (arg == "--chassis-radius") {
-        options.chassis_radius_px = number(value(), arg);
+        options.chassis_radius_px = parseNumber(value(), arg);
       } else if (arg == "--bearing-sign") {
-        const double s = number(value(), arg);
+        const double s = parseNumber(value(), arg);
         if (s != 1 && s != -1) throw std::invalid_argument("--bearing-sign must be 1 or -1");
         options.bearing_sign = static_cast<int>(s);
         options.bearing_sign_prior = static_cast<int>(s);
       } else if (arg == "--bearing-offset") {
-        options.bearing_offset_rad = number(value(), arg);
+        options.bearing_offset_rad = parseNumber(value(), arg);
       } else if (arg == "--max-residual") {
-        options.max_median_residual_m = number(value(), arg);
+        options.max_median_residual_m = parseNumber(value(), arg);
       } else if (arg == "--min-inliers") {
-        options.min_inlier_fraction = number(value(), arg);
+        options.min_inlier_fraction = parseNumber(value(), arg);
       } else if (arg == "--profile") {
         options.profile = value();
         if (options.profile != "auto" && options.profile != "tan" && options.profile != "monotone") {
           throw std::invalid_argument("--profile must be auto, tan or monotone");
         }
       } else if (arg == "--max-carpet-on-lines") {
-        options.max_carpet_on_lines = number(value(), arg);
+        options.max_carpet_on_lines = parseNumber(value(), arg);
       } else if (arg == "--output") {
         output = value();
       } else if (arg == "--overlay") {

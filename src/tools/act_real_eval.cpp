@@ -1,6 +1,7 @@
 // act_real_eval: ACT on real camera images (issue 12, item 4). For every folder given (or every
 // folder of --dir) with an image (pic_save0.png) and, optionally, hand-picked line pixels
-// (whites.txt): the camera calibration fitted to the image (as act_calibrate does), then ACT from
+// (whites.txt): the camera calibration fitted to the image (as act_calibrate does: the field of a
+// preset or of a calibration file, the robot at a rough pose), then ACT from
 // that image at the fitted pose, and the image under five changes of light as 60-frame sequences
 // with fresh noise, for the defaults and the paper side by side.
 #include <dirent.h>
@@ -14,19 +15,26 @@
 #include <string>
 #include <vector>
 
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/mirror_calibrator.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/sim/real_image_suite.hpp"
+#include "cli_numbers.hpp"
 
 namespace {
 
 void printUsage(std::ostream& out) {
-  out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007] [--set NAME=VALUE]\n"
-         "                    [--png DIR] [--frames]\n"
+  out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007 | --field CAL.yaml]\n"
+         "                    [--pose x,y,theta] [--height-m H] [--set NAME=VALUE] [--png DIR] [--frames]\n"
          "  --dir DIR      every folder of DIR that holds the image\n"
          "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
          "                 and CTableBGR.dat (NuBot's hand-made table, compared with ACT's)\n"
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
-         "  --preset NAME  the field (lab6x4); the robot is taken to stand on the centre spot facing +x\n"
+         "  --preset NAME  the field (lab6x4)\n"
+         "  --field CAL.yaml  the field section of this calibration instead (your field)\n"
+         "  --pose x,y,theta  the robot's rough pose (m, m, rad) in every image, for the fit (default\n"
+         "                 0,0,0: on the centre spot facing +x, the yellow goal)\n"
+         "  --height-m H   the camera's viewpoint height for the fit (default 0.7)\n"
          "  --png DIR      each image beside its classes (defaults) as PNGs: the frame before the change\n"
          "                 (NAME_classified.png) and the last frame of each variant (NAME_VARIANT.png)\n"
          "  --set NAME=VALUE  an ActParams parameter of the defaults (repeatable; e.g. seed=2)\n"
@@ -56,7 +64,9 @@ bool isFile(const std::string& path) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> folders;
-  std::string dir, png_dir, image_name = "pic_save0.png", preset = "lab6x4";
+  std::string dir, png_dir, image_name = "pic_save0.png", preset, field_path;
+  act_color::core::MirrorCalibratorOptions calibrator;
+  act_color::core::FieldCalibration field;
   bool frames = false;
   act_color::core::ActParams defaults;
   try {
@@ -75,6 +85,16 @@ int main(int argc, char** argv) {
         image_name = value();
       } else if (arg == "--preset") {
         preset = value();
+      } else if (arg == "--field") {
+        field_path = value();
+      } else if (arg == "--pose") {
+        const auto p = act_color_tools::parseNumbers(value(), 3, arg);
+        calibrator.pose = {p[0], p[1], p[2]};
+      } else if (arg == "--height-m") {
+        calibrator.height_m = act_color_tools::parseNumber(value(), arg);
+        if (!(calibrator.height_m > 0 && calibrator.height_m < 10)) {
+          throw std::invalid_argument("--height-m must be in (0, 10) m");
+        }
       } else if (arg == "--png") {
         png_dir = value();
       } else if (arg == "--frames") {
@@ -101,6 +121,9 @@ int main(int argc, char** argv) {
       for (const auto& n : names) folders.push_back(dir + "/" + n);
     }
     if (folders.empty()) throw std::invalid_argument("no folder with " + image_name);
+    if (!preset.empty() && !field_path.empty()) throw std::invalid_argument("give --preset or --field, not both");
+    field = field_path.empty() ? act_color::core::fieldPreset(preset.empty() ? "lab6x4" : preset)
+                               : act_color::core::loadCalibration(field_path).field;
   } catch (const std::exception& e) {
     std::cerr << "act_real_eval: " << e.what() << "\n";
     printUsage(std::cerr);
@@ -128,12 +151,8 @@ int main(int argc, char** argv) {
     image.nubot_table = act_color::sim::readNubotTable(folder + "/CTableBGR.dat");
     act_color::sim::BallMark ball;
     if (act_color::sim::readBallMark(folder + "/ball.txt", &ball)) image.ball = ball;
-    try {
-      image.field = act_color::core::fieldPreset(preset);
-    } catch (const std::exception& e) {
-      std::cerr << "act_real_eval: " << e.what() << "\n";
-      return 2;
-    }
+    image.field = field;
+    image.calibrator = calibrator;
     results.push_back(act_color::sim::evaluateRealImage(image, modes));
     const auto& r = results.back();
     if (!png_dir.empty() && !r.labels_before.empty()) {
