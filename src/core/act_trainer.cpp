@@ -541,16 +541,17 @@ double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
   return params_.evidence_removal_ratio;
 }
 
-uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3]) const {
+uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3], double dark_limit) const {
   // Robots stand on the carpet and in front of the goals: there, a robot's color is what the pose
   // cannot foresee.
   if ((k != kGreen && k != kYellow && k != kBlue) || !params_.robots_train_black) return k;
   const ClassCluster& green = clusters_[kGreen];
   if (!green.trained()) return k;
+  const double intensity = c[0] + c[1] + c[2];
+  if (intensity >= dark_limit) return k;  // most samples: the carpet is brighter
   const int lo = std::min({c[0], c[1], c[2]});
   const int hi = std::max({c[0], c[1], c[2]});
-  const double intensity = c[0] + c[1] + c[2];
-  if (intensity >= darkLimit() || hi - lo > 0.35 * hi + 8) return k;
+  if (hi - lo > 0.35 * hi + 8) return k;
   const Eigen::Vector3d color(c[0], c[1], c[2]);
   return (color - green.mean()).norm() > params_.zeta * green.sigma() ? static_cast<uint8_t>(kBlack) : k;
 }
@@ -906,13 +907,14 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   // 2.2: cluster update from every n-th pixel.
   for (auto& s : samples_) s.clear();
   carpet_samples_.clear();
+  double dark_limit = darkLimit();
   everyNth(params_.cluster_stride, [&](const StridedPixels& p) {
     const uint8_t expected_k = expected(p);
     if (expected_k == kUnknown || expected_k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
     if (expected_k == kGreen && params_.light_compensation) carpet_samples_.emplace_back(c[0], c[1], c[2]);
-    samples_[trainedClass(expected_k, c)].emplace_back(c[0], c[1], c[2]);
+    samples_[trainedClass(expected_k, c, dark_limit)].emplace_back(c[0], c[1], c[2]);
   });
   if (params_.light_compensation) {
     // A closer look before the whole table moves: carpet and lines of this frame at the stride of
@@ -948,12 +950,13 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
       denseAddCycle() ? std::min(params_.add_stride, params_.light_change_add_stride) : params_.add_stride;
   add_weight_ = samplingStride(add_stride);
   prepareNearestMean();
+  dark_limit = darkLimit();  // of the clusters just moved
   everyNth(add_stride, [&](const StridedPixels& p) {
     const uint8_t k = expected(p);
     if (k == kUnknown || k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
-    const uint8_t trained = trainedClass(k, c);
+    const uint8_t trained = trainedClass(k, c, dark_limit);
     stats.added[trained] += addColor(c, trained);
   });
 

@@ -228,8 +228,8 @@ class ActTrainer {
   // cluster than to k's, in units of sigma.
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
   // The class a sample expected as k trains (robots_train_black re-routes green and goal colors
-  // of robots to black).
-  uint8_t trainedClass(uint8_t k, const uint8_t c[3]) const;
+  // of robots to black); `dark_limit` is darkLimit() of the clusters the pass samples against.
+  uint8_t trainedClass(uint8_t k, const uint8_t c[3], double dark_limit) const;
   // ActParams::learned_boundary: counts this cycle's pixels near the carpet-line boundary, learns
   // the split from the counts and removes the white cells that lie wholly on the carpet's side.
   void learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
