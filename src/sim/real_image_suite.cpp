@@ -69,12 +69,29 @@ RealImageResult evaluateRealImage(const RealImage& image,
                                   const std::vector<std::pair<std::string, core::ActParams>>& modes, uint32_t seed) {
   RealImageResult result;
   result.name = image.name;
-  try {
-    result.fit = core::MirrorCalibrator(image.field, image.calibrator).fit(image.bgr);
+  if (image.calibration) {
+    const core::CameraCalibration& camera = image.calibration->camera;
+    if (image.bgr.cols != camera.width || image.bgr.rows != camera.height) {
+      result.why = "the image is " + std::to_string(image.bgr.cols) + "x" + std::to_string(image.bgr.rows) +
+                   ", the calibration is for " + std::to_string(camera.width) + "x" + std::to_string(camera.height);
+      return result;
+    }
+    // The calibration as given, measured on the image's line pixels as act_calibrate --check does.
+    const core::MirrorCalibrator calibrator(image.calibration->field, image.calibrator);
+    result.fit.calibration = *image.calibration;
+    result.fit.pose = image.calibrator.pose;
+    result.fit.profile = "given";
+    result.fit.line_pixels = calibrator.findLinePixels(image.bgr, core::imageGeometryOf(camera));
+    result.fit.residual = calibrator.residual(camera, result.fit.pose, result.fit.line_pixels);
     result.fitted = true;
-  } catch (const std::exception& e) {
-    result.why = e.what();
-    return result;
+  } else {
+    try {
+      result.fit = core::MirrorCalibrator(image.field, image.calibrator).fit(image.bgr);
+      result.fitted = true;
+    } catch (const std::exception& e) {
+      result.why = e.what();
+      return result;
+    }
   }
   core::Calibration cal = result.fit.calibration;
   const core::Pose2D pose = result.fit.pose;
@@ -85,8 +102,9 @@ RealImageResult evaluateRealImage(const RealImage& image,
   cv::cvtColor(image.bgr, rgb, cv::COLOR_BGR2RGB);
   // The own robot's parts (item 3) from this one image: ACT's start-up table at the fitted pose,
   // then the pixels that show neither carpet nor line where the pose expects one, in the shape of
-  // a strut or touching the chassis. They train nothing and are left out of the figures.
-  {
+  // a strut or touching the chassis. They train nothing and are left out of the figures. A given
+  // calibration's own mask is kept.
+  if (cal.camera.self_mask.empty()) {
     core::ActTrainer trainer(cal);
     const core::ImageView view = core::ImageView::fromMat(rgb, core::PixelFormat::kRgb8);
     trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles);
@@ -94,8 +112,8 @@ RealImageResult evaluateRealImage(const RealImage& image,
     learner.add(view, pose, trainer.lut());
     cal.camera.self_mask = learner.mask();
     cal.camera.self_mask_file = "self_mask.png";
-    result.self_mask = cal.camera.self_mask;
   }
+  result.self_mask = cal.camera.self_mask;
   // Expected classes at the fitted pose (without eq. 1: the geometry alone).
   const core::ExpectedClassModel model(cal);
   const core::PoseTransform transform(pose);
@@ -343,14 +361,15 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
       out << r.name << ": not fitted (" << r.why << ")\n\n";
       continue;
     }
-    std::snprintf(line, sizeof(line),
-                  "%s: %s profile, residual %.3f m, pose (%.2f, %.2f, %.1f deg), %zu hand-picked white pixels, "
-                  "self mask %.1f%% of the image\n\n",
-                  r.name.c_str(), r.fit.profile.c_str(), r.fit.residual.median_m, r.fit.pose.x_m, r.fit.pose.y_m,
-                  r.fit.pose.theta_rad * 180.0 / M_PI, r.whites,
-                  r.self_mask.empty() ? 0.0
-                                      : 100.0 * std::count(r.self_mask.begin(), r.self_mask.end(), uint8_t{1}) /
-                                            static_cast<double>(r.self_mask.size()));
+    std::snprintf(
+        line, sizeof(line),
+        "%s: %s, residual %.3f m, pose (%.2f, %.2f, %.1f deg), %zu hand-picked white pixels, "
+        "self mask %.1f%% of the image\n\n",
+        r.name.c_str(), r.fit.profile == "given" ? "the calibration given" : (r.fit.profile + " profile").c_str(),
+        r.fit.residual.median_m, r.fit.pose.x_m, r.fit.pose.y_m, r.fit.pose.theta_rad * 180.0 / M_PI, r.whites,
+        r.self_mask.empty() ? 0.0
+                            : 100.0 * std::count(r.self_mask.begin(), r.self_mask.end(), uint8_t{1}) /
+                                  static_cast<double>(r.self_mask.size()));
     out << line;
     if (r.nubot_green_agreement >= 0) {
       std::snprintf(line, sizeof(line),

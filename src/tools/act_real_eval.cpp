@@ -12,6 +12,7 @@
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,8 @@
 namespace {
 
 void printUsage(std::ostream& out) {
-  out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME] [--preset lab6x4|msl2007 | --field CAL.yaml]\n"
+  out << "usage: act_real_eval (--dir DIR | FOLDER...) [--image NAME]\n"
+         "                    [--preset lab6x4|msl2007 | --field CAL.yaml | --calibration CAL.yaml]\n"
          "                    [--pose x,y,theta] [--height-m H] [--set NAME=VALUE] [--png DIR] [--frames]\n"
          "  --dir DIR      every folder of DIR that holds the image\n"
          "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
@@ -32,6 +34,8 @@ void printUsage(std::ostream& out) {
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
          "  --preset NAME  the field (lab6x4)\n"
          "  --field CAL.yaml  the field section of this calibration instead (your field)\n"
+         "  --calibration CAL.yaml  this calibration (camera, field, self mask) instead of a fit; the\n"
+         "                 robot stands at --pose exactly\n"
          "  --pose x,y,theta  the robot's rough pose (m, m, rad) in every image, for the fit (default\n"
          "                 0,0,0: on the centre spot facing +x, the yellow goal)\n"
          "  --height-m H   the camera's viewpoint height for the fit (default 0.7)\n"
@@ -64,7 +68,9 @@ bool isFile(const std::string& path) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> folders;
-  std::string dir, png_dir, image_name = "pic_save0.png", preset, field_path;
+  std::string dir, png_dir, image_name = "pic_save0.png", preset, field_path, calibration_path;
+  std::optional<act_color::core::Calibration> calibration;
+  bool height_given = false;
   act_color::core::MirrorCalibratorOptions calibrator;
   act_color::core::FieldCalibration field;
   bool frames = false;
@@ -87,11 +93,14 @@ int main(int argc, char** argv) {
         preset = value();
       } else if (arg == "--field") {
         field_path = value();
+      } else if (arg == "--calibration") {
+        calibration_path = value();
       } else if (arg == "--pose") {
         const auto p = act_color_tools::parseNumbers(value(), 3, arg);
         calibrator.pose = {p[0], p[1], p[2]};
       } else if (arg == "--height-m") {
         calibrator.height_m = act_color_tools::parseNumber(value(), arg);
+        height_given = true;
         if (!(calibrator.height_m > 0 && calibrator.height_m < 10)) {
           throw std::invalid_argument("--height-m must be in (0, 10) m");
         }
@@ -121,9 +130,17 @@ int main(int argc, char** argv) {
       for (const auto& n : names) folders.push_back(dir + "/" + n);
     }
     if (folders.empty()) throw std::invalid_argument("no folder with " + image_name);
-    if (!preset.empty() && !field_path.empty()) throw std::invalid_argument("give --preset or --field, not both");
-    field = field_path.empty() ? act_color::core::fieldPreset(preset.empty() ? "lab6x4" : preset)
-                               : act_color::core::loadCalibration(field_path).field;
+    if (!preset.empty() + !field_path.empty() + !calibration_path.empty() > 1) {
+      throw std::invalid_argument("give one of --preset, --field and --calibration");
+    }
+    if (!calibration_path.empty()) {
+      if (height_given) throw std::invalid_argument("--height-m is the calibration's with --calibration");
+      calibration = act_color::core::loadCalibration(calibration_path);
+      field = calibration->field;
+    } else {
+      field = field_path.empty() ? act_color::core::fieldPreset(preset.empty() ? "lab6x4" : preset)
+                                 : act_color::core::loadCalibration(field_path).field;
+    }
   } catch (const std::exception& e) {
     std::cerr << "act_real_eval: " << e.what() << "\n";
     printUsage(std::cerr);
@@ -153,6 +170,7 @@ int main(int argc, char** argv) {
     if (act_color::sim::readBallMark(folder + "/ball.txt", &ball)) image.ball = ball;
     image.field = field;
     image.calibrator = calibrator;
+    image.calibration = calibration;
     results.push_back(act_color::sim::evaluateRealImage(image, modes));
     const auto& r = results.back();
     if (!png_dir.empty() && !r.labels_before.empty()) {

@@ -57,6 +57,15 @@ TEST(ActRealEval, RunsOnAnImageOfYourFieldWithYourCalibration) {
     EXPECT_EQ(shown.rows, bgr.rows) << variant;
   }
   EXPECT_FALSE(cv::imread(png + "/our_robot_pic_save0_classified.png").empty());
+
+  // The calibration file act_calibrate wrote for the camera (here: the truth), the robot where it is.
+  const std::string exact =
+      std::to_string(pose.x_m) + "," + std::to_string(pose.y_m) + "," + std::to_string(pose.theta_rad);
+  const act_color_tool_test::ToolRun given = run(folder + " --calibration " + field + " --pose " + exact);
+  ASSERT_EQ(given.exit_code, 0) << given.output;
+  EXPECT_NE(given.output.find("our_robot/pic_save0.png: the calibration given, residual 0.0"), std::string::npos)
+      << given.output;
+  EXPECT_NE(given.output.find("| darken | defaults | - | - | "), std::string::npos) << given.output;
 }
 
 TEST(ActRealEval, RefusesWhatItCannotUse) {
@@ -69,6 +78,17 @@ TEST(ActRealEval, RefusesWhatItCannotUse) {
   EXPECT_EQ(run(folder + " --height-m -1").exit_code, 2);
   EXPECT_EQ(run(folder + " --bogus").exit_code, 2);
   EXPECT_EQ(run(tempDir() + "/no_such_folder").exit_code, 1);
+  // A calibration comes with its field and camera height.
+  const std::string cal = tempDir() + "/other_camera.yaml";
+  core::Calibration other = sim::makeFamilyScene(1003u, sim::ScenarioLength::kSmall, false).calibration;
+  other.camera.width = 640;  // another image size than the folder's
+  std::ofstream(cal) << core::toYaml(other);
+  EXPECT_EQ(run(folder + " --calibration " + cal + " --preset lab6x4").exit_code, 2);
+  EXPECT_EQ(run(folder + " --calibration " + cal + " --height-m 0.7").exit_code, 2);
+  const act_color_tool_test::ToolRun sized = run(folder + " --calibration " + cal);
+  EXPECT_EQ(sized.exit_code, 0) << sized.output;
+  EXPECT_NE(sized.output.find("not fitted (the image is 480x480, the calibration is for 640x"), std::string::npos)
+      << sized.output;
   // A grey image has no field to fit: said so, no figures.
   const act_color_tool_test::ToolRun grey = run(folder);
   EXPECT_EQ(grey.exit_code, 0) << grey.output;

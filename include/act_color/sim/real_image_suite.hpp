@@ -37,6 +37,10 @@ struct RealImage {
   std::vector<uint8_t> nubot_table;
   std::optional<BallMark> ball;  // the ball marked by eye (issue 13); none when the folder has no ball.txt
   core::FieldCalibration field;
+  // A calibration to use instead of fitting one (e.g. act_calibrate's file of this camera), with the
+  // robot at calibrator.pose exactly; its field replaces `field`, and its self mask, when it has
+  // one, the mask learned from the image.
+  std::optional<core::Calibration> calibration;
 };
 
 constexpr int kRealFramesBefore = 20;
