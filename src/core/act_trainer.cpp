@@ -1147,7 +1147,6 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
 
 void ActTrainer::selectRemovalCandidates(size_t start) {
   const RemovalSamples& samples = removalSamples(start);
-  removal_start_ = start;
   const double h = model_.camera().viewpointHeight(), robot = params_.robot_height_m;
   robot_reach_ = h > robot ? h / (h - robot) : std::numeric_limits<double>::infinity();
   robot_sectors_.fill(kRobotUnknown);
@@ -1166,8 +1165,9 @@ void ActTrainer::selectRemovalCandidates(size_t start) {
     candidate_sectors_.resize(candidates_.size(), static_cast<uint8_t>(sector));
     const auto band_end = std::partition_point(
         on_carpet, last, [&](const RemovalSample& sample) { return sample.range_m * robot_reach_ >= safe_range; });
-    robot_bands_[static_cast<size_t>(sector)] = {static_cast<uint32_t>(on_carpet - samples.samples.begin()),
-                                                 static_cast<uint32_t>(band_end - samples.samples.begin())};
+    const RemovalSample* data = samples.samples.data();
+    robot_bands_[static_cast<size_t>(sector)] = {data + (on_carpet - samples.samples.begin()),
+                                                 data + (band_end - samples.samples.begin())};
   }
 }
 
@@ -1182,12 +1182,10 @@ bool ActTrainer::maybeRobot(int sector, float range_m, const Pixels& pixels) {
     if (state == kRobotUnknown) {
       state = kNoRobot;
       const auto [begin, end] = robot_bands_[static_cast<size_t>(s)];
-      const std::vector<RemovalSample>& samples = removalSamples(removal_start_).samples;
       int black = 0;
-      for (uint32_t i = begin; i < end && state == kNoRobot; ++i) {
-        const RemovalSample& sample = samples[i];
+      for (const RemovalSample* sample = begin; sample != end && state == kNoRobot; ++sample) {
         uint8_t c[3];
-        pixels.color(sample.pixel, sample.u, sample.v, c);
+        pixels.color(sample->pixel, sample->u, sample->v, c);
         if (lut_.classOf(c[0], c[1], c[2]) == kBlack && ++black >= kMinRobotSamples) state = kRobot;
       }
     }

@@ -389,12 +389,11 @@ class ActTrainer {
   void selectRemovalCandidates(size_t start);
   // ActParams::robot_height_m. A robot standing at floor range d is imaged out to d * robot_reach_
   // (its top). Per sector, this cycle's samples on the carpet from safe range / robot_reach_ on (a
-  // robot there is imaged beyond the carpet's edge), indices into removalSamples(removal_start_);
-  // and whether one of them is black in the table, looked at when a black candidate first asks
-  // (kRobotUnknown before).
-  size_t removal_start_ = 0;
+  // robot there is imaged beyond the carpet's edge), a range of removalSamples' list; and whether
+  // one of them is black in the table, looked at when a black candidate first asks (kRobotUnknown
+  // before).
   double robot_reach_ = 1.0;
-  std::array<std::pair<uint32_t, uint32_t>, ExpectedClassModel::kRemovalSectors> robot_bands_{};
+  std::array<std::pair<const RemovalSample*, const RemovalSample*>, ExpectedClassModel::kRemovalSectors> robot_bands_{};
   std::array<uint8_t, ExpectedClassModel::kRemovalSectors> robot_sectors_{};
   static constexpr uint8_t kRobotUnknown = 0, kNoRobot = 1, kRobot = 2;
   // An off-field sample of `sector` at floor range `range_m` may show such a robot (of this sector
