@@ -512,8 +512,9 @@ Eigen::VectorXd leastSquares(const std::function<void(const Eigen::VectorXd&, Ei
 
 // Camera of a model: the elevation map sampled densely from the tan profile or the monotone knots,
 // from the chassis to the mirror rim (beyond the fitted range the profile is continued).
+// `tan_p`: the tan fit's parameters, whose shape a monotone profile follows beyond its last knot.
 CameraCalibration cameraOf(const Model& model, const Eigen::VectorXd& p, const ImageGeometry& geometry, int width,
-                           int height, double bearing_offset, const Eigen::VectorXd* tan_tail = nullptr) {
+                           int height, double bearing_offset, const Eigen::VectorXd& tan_p) {
   CameraCalibration c;
   c.width = width;
   c.height = height;
@@ -560,25 +561,18 @@ CameraCalibration cameraOf(const Model& model, const Eigen::VectorXd& p, const I
     if (r1 > model.knots_r.back()) {
       const size_t n = e.size();
       const double r_last = model.knots_r[n - 1];
-      if (tan_tail) {
-        // Beyond the farthest line pixels no line decides: the tan fit's shape, joined at the last
-        // knot. A straight continuation of the last segment drew the hall of nubot_1_bak_bak onto
-        // the goal's box (its yellow wall trained as the goal, 17% of the hall in a field class).
-        Model tan_model = model;
-        tan_model.kind = ProfileKind::kTan;
-        const double r_h = std::exp((*tan_tail)[Model::kGeometry + 1]);
-        const auto tanElevation = [&](double r) {
-          return tan_model.elevation(std::min(r, 0.995 * r_h), *tan_tail, {});
-        };
-        const double e_tan_last = tanElevation(r_last);
-        constexpr int kTailSamples = 12;
-        for (int i = 1; i <= kTailSamples; ++i) {
-          const double r = r_last + (r1 - r_last) * i / kTailSamples;
-          push(r, e[n - 1] + tanElevation(r) - e_tan_last);
-        }
-      } else {
-        const double slope = (e[n - 1] - e[n - 2]) / (model.knots_r[n - 1] - model.knots_r[n - 2]);
-        push(r1, e[n - 1] + slope * (r1 - r_last));
+      // Beyond the farthest line pixels no line decides: the tan fit's shape, joined at the last
+      // knot. A straight continuation of the last segment drew the hall of nubot_1_bak_bak onto the
+      // goal's box (its yellow wall trained as the goal, 17% of the hall in a field class).
+      Model tan_model;
+      tan_model.height_m = model.height_m;
+      const double r_h = std::exp(tan_p[Model::kGeometry + 1]);
+      const auto tanElevation = [&](double r) { return tan_model.elevation(std::min(r, 0.995 * r_h), tan_p, {}); };
+      const double e_tan_last = tanElevation(r_last);
+      constexpr int kTailSamples = 12;
+      for (int i = 1; i <= kTailSamples; ++i) {
+        const double r = r_last + (r1 - r_last) * i / kTailSamples;
+        push(r, e[n - 1] + tanElevation(r) - e_tan_last);
       }
     }
   }
@@ -790,19 +784,17 @@ std::vector<cv::Point2f> MirrorCalibrator::findLinePixels(const cv::Mat& bgr, co
   // below its middle, and on the noisiest real cameras (nubot_100, nubot_101) thousands of specks
   // of the carpet's own noise passed as line pixels and no fit was accepted.
   const int k = std::max(9, static_cast<int>(g.mirror_radius_px / 12) | 1);
-  cv::Mat grey, background;
+  cv::Mat grey, background, above_median;
   masks.luma.convertTo(grey, CV_8U);
   cv::medianBlur(grey, background, k);
-  cv::Mat tophat;
-  background.convertTo(tophat, CV_32F);
-  tophat = masks.luma - tophat;
+  cv::subtract(grey, background, above_median, cv::noArray(), CV_32F);
   cv::Mat blurred;
   cv::GaussianBlur(masks.luma, blurred, {0, 0}, 1.0);
   cv::Mat noise;
   cv::absdiff(masks.luma, blurred, noise);
   const double noise_level = cv::mean(noise)[0];
   const double threshold = std::max(14.0, 4.0 * noise_level);
-  cv::Mat bright = tophat > threshold;
+  cv::Mat bright = above_median > threshold;
   // Lines are painted on the carpet: green next to them, and within a few pixels on both sides
   // along one of four directions. The carpet's own edge (the grey floor or a wall beyond the
   // margin) has it on one side only; taken for a line it let fits shrink the profile at the rim
@@ -1136,7 +1128,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
       offset = *options_.bearing_offset_rad;
       refined_pose->theta_rad = wrapAngle(c.p[2] - offset);
     }
-    cal->camera = cameraOf(c.model, c.p, fitted_geometry, bgr.cols, bgr.rows, offset, &tan.p);
+    cal->camera = cameraOf(c.model, c.p, fitted_geometry, bgr.cols, bgr.rows, offset, tan.p);
     cal->field = field_;
     return residual(cal->camera, *refined_pose, pixels);
   };
