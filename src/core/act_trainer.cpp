@@ -81,6 +81,11 @@ constexpr uint64_t kDenseAddCycles = 8;
 // median 0.75 -> 0.79 instead of 0.80, F1 up by 0.02 or more in 64 segments, down in 1).
 constexpr int kMinRobotSamples = 10;
 
+// ActTrainer::markAbsentGoals: a goal's mean this near white's, in units of the distance from
+// green's mean to white's, is the lines' color (a distance ratio: a change of gain, brightness and
+// contrast keeps it).
+constexpr double kAbsentGoalFraction = 0.25;
+
 // Pixels the cluster and addition steps fetch ahead of the one they look at.
 constexpr int kSamplesAhead = 16;
 
@@ -265,6 +270,7 @@ void ActTrainer::reset(ColorSpace space) {
   restartPoseCheck();
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
+  absent_.fill(false);
   boundary_line_.fill(0.f);
   boundary_carpet_.fill(0.f);
   boundary_t_ = 0.5;
@@ -306,6 +312,7 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   dark_frozen_ = false;
   light_states_.clear();
   last_light_change_ = 0;
+  absent_.fill(false);
   restartPoseCheck();  // a table from elsewhere: not yet confirmed here
   space_known_ = true;
 }
@@ -340,6 +347,7 @@ ClusterParams ActTrainer::clusterParams() const {
 }
 
 uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k, bool ball_sighting) {
+  if (absent_[k]) return 0;
   const ClassCluster& cluster = clusters_[k];
   const Eigen::Vector3d color(c[0], c[1], c[2]);
   const double radius = params_.zeta * cluster.sigma();
@@ -577,7 +585,7 @@ void ActTrainer::prepareNearestMean() {
   for (int k = 1; k < kNumClasses; ++k) {
     const Eigen::Vector3d& own = clusters_[k].mean();
     for (int j = 1; j < kNumClasses; ++j) {
-      if (j == k || !clusters_[j].trained()) continue;
+      if (j == k || !clusters_[j].trained() || absent_[j]) continue;
       // The goal region decides between a goal and the ball: the ball's mean takes no goal color.
       if (j == kOrange && (k == kYellow || k == kBlue)) continue;
       const Eigen::Vector3d& other = clusters_[j].mean();
@@ -592,6 +600,27 @@ void ActTrainer::prepareNearestMean() {
         continue;
       }
       mean_boundaries_[k].push_back({2.0 * a * (own - other), own.dot(a * own) - other.dot(a * other)});
+    }
+  }
+}
+
+void ActTrainer::markAbsentGoals(CycleStats& stats) {
+  const bool was_absent[2] = {absent_[kYellow], absent_[kBlue]};
+  absent_.fill(false);
+  const ClassCluster& green = clusters_[kGreen];
+  const ClassCluster& white = clusters_[kWhite];
+  if (!params_.nearest_mean || !green.trained() || !white.trained()) return;
+  const double scale = (white.mean() - green.mean()).norm();
+  for (const uint8_t k : {kYellow, kBlue}) {
+    absent_[k] = clusters_[k].trained() && (clusters_[k].mean() - white.mean()).norm() < kAbsentGoalFraction * scale;
+  }
+  if ((absent_[kYellow] && !was_absent[0]) || (absent_[kBlue] && !was_absent[1])) {
+    for (uint32_t cell = 0; cell < lut_.size(); ++cell) {
+      const uint8_t k = lut_.at(cell);
+      if (k < kNumClasses && absent_[k]) {
+        removeCell(cell);
+        ++stats.removed[k];
+      }
     }
   }
 }
@@ -714,6 +743,7 @@ bool ActTrainer::restoreLightState() {
   // The light restored keeps its reference and takes this cycle's anchors from the light left.
   light_.adoptObservation(best->light);
   rebuildMapped();
+  absent_.fill(false);  // the restored table may hold an absent goal's cells: cleared again
   ball_hypotheses_.clear();
   return true;
 }
@@ -943,6 +973,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
   }
 
+  markAbsentGoals(stats);
   if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
   if (stats.light_change) last_light_change_ = revision_ + 1;

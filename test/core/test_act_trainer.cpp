@@ -842,3 +842,45 @@ TEST_F(ActTrainerTest, ARobotAtTheCarpetsEdgeKeepsItsColorThoughItIsImagedOverTh
   EXPECT_GT(on_carpet, 20);
   EXPECT_NE(run(0.0, &on_carpet, &beyond), kBlack);  // every off-field sample counts: removed
 }
+
+TEST_F(ActTrainerTest, AFieldWithoutGoalsLeavesTheLinesWhite) {
+  // A lab field without goals: where the model expects the goals, the hall's white walls, a shade
+  // brighter than the lines. Yellow's and blue's clusters learn the walls; the goals are then taken
+  // as absent (their means lie with white's, far from green's): no cell is a goal's and the lines'
+  // color stays white. The same field with its goals keeps them.
+  const Pose2D facing_goal{1.0, 0.3, 0.2};
+  const auto with_goals = paintFlatFrame(model, facing_goal, 1.0, 1);
+  cv::Mat without_goals = with_goals.rgb.clone();
+  const PoseTransform t(facing_goal);
+  cv::Vec3b line(0, 0, 0);
+  int goal_pixels = 0;
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      if (model.geometricClass(v * 580 + u, t) == kWhite) line = with_goals.rgb.at<cv::Vec3b>(v, u);
+    }
+  }
+  const cv::Vec3b wall(std::min(255, line[0] + 3), std::min(255, line[1] + 4), std::min(255, line[2] + 8));
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      const uint8_t k = model.geometricClass(v * 580 + u, t);
+      if (k != kYellow && k != kBlue) continue;
+      ++goal_pixels;
+      without_goals.at<cv::Vec3b>(v, u) = wall;
+    }
+  }
+  ASSERT_GT(goal_pixels, 1000);
+  for (uint32_t seed = 1; seed <= 3; ++seed) {
+    ActParams p;
+    p.seed = seed;
+    ActTrainer trainer(cal, p);
+    trainer.bootstrap(view(without_goals), facing_goal, 20);
+    EXPECT_LT((trainer.clusters()[kYellow].mean() - Eigen::Vector3d(wall[0], wall[1], wall[2])).norm(), 30.0);
+    EXPECT_EQ(trainer.lut().cellCounts()[kYellow], 0u) << "seed " << seed;
+    EXPECT_EQ(trainer.lut().cellCounts()[kBlue], 0u) << "seed " << seed;
+    EXPECT_EQ(trainer.lut().classOf(line[0], line[1], line[2]), kWhite) << "seed " << seed;
+    ActTrainer control(cal, p);
+    control.bootstrap(view(with_goals.rgb), facing_goal, 20);
+    EXPECT_GT(control.lut().cellCounts()[kYellow], 0u) << "seed " << seed;
+    EXPECT_GT(control.lut().cellCounts()[kBlue], 0u) << "seed " << seed;
+  }
+}

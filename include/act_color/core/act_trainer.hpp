@@ -69,7 +69,8 @@ struct ActParams {
   bool robots_train_black = true;
   // A color joins class k only when k's cluster mean is the nearest of the trained clusters'
   // means: the table splits mixed colors (the blurred edge of a line on the carpet) where they are
-  // half one class and half the other, not at zeta * sigma of the wider cluster.
+  // half one class and half the other, not at zeta * sigma of the wider cluster. A goal whose mean
+  // lies with white's (markAbsentGoals) is absent: a lab field without goals.
   bool nearest_mean = true;
   // Each table cell counts, with a half-life of kEvidenceHalfLifeCycles, the pixels estimated to
   // show its color in the field as its class (in-field samples x add stride) and off the field
@@ -224,6 +225,10 @@ class ActTrainer {
   // Uses the boundaries from prepareNearestMean(), made after this cycle's cluster update.
   bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
   void prepareNearestMean();
+  // ActParams::nearest_mean: a goal whose cluster mean lies nearer to white's than
+  // kAbsentGoalFraction of the distance from green's to white's is taken as absent this cycle
+  // (a lab field without goals: its region shows the hall's white walls); its cells are cleared.
+  void markAbsentGoals(CycleStats& stats);
   // True when the color is mapped to a trained class other than k and is nearer to that class's
   // cluster than to k's, in units of sigma.
   bool claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const;
@@ -296,6 +301,8 @@ class ActTrainer {
     double offset;
   };
   std::array<std::vector<MeanBoundary>, kNumClasses> mean_boundaries_;
+  // markAbsentGoals: the goals taken as absent this cycle.
+  std::array<bool, kNumClasses> absent_{};
   // ActParams::learned_boundary: decayed counts of line (eq. 1) and carpet pixels next to a line by
   // their position t along the axis from green's mean (0) to white's (1), kBoundaryBins bins over
   // [kBoundaryLow, kBoundaryHigh); the split position learned from them (0.5: the middle).
