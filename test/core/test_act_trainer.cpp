@@ -719,9 +719,10 @@ TEST_F(ActTrainerTest, AColorTheFieldShowsFarMoreOftenThanTheHallStaysBeyondXiSi
 TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   // The lines in the top quarter of the image painted in one color, and the hall beside the field
   // in the same color on some rows: a saturated line and a saturated lamp are one color. Seen off
-  // the field some eight times as often as in it, an unclipped color is removed (the ratio is 3)
-  // and a clipped one stays (its ratio is 10); seen off the field everywhere (some 60 times as
-  // often), it is removed too.
+  // the field some four times as often as in it, an unclipped color is removed (the ratio is 3;
+  // it comes back when its in-field count catches up, in some 2 cycles of 10) and a clipped one
+  // stays (its ratio is 5); seen off the field everywhere (some 30 times as often), it is removed
+  // too.
   const Pose2D near_corner{7.5, 4.5, 0.0};
   const auto clean = paintFlatFrame(model, near_corner, 1.0, 1);
   const PoseTransform t(near_corner);
@@ -734,8 +735,17 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   }
   const int line_pixels = cv::countNonZero(lines);
   ASSERT_GT(line_pixels, 1000);
-  const int some_rows = cv::countNonZero(hall) / (8 * line_pixels);
-  ASSERT_GE(some_rows, 2);
+  // The row step whose painted hall pixels come nearest to four times the line pixels.
+  auto paintedRatio = [&](int every_nth_row) {
+    int painted = 0;
+    for (int v = 0; v < 580; v += every_nth_row) painted += cv::countNonZero(hall.row(v));
+    return static_cast<double>(painted) / line_pixels;
+  };
+  int some_rows = 2;
+  for (int n = 3; n < 60; ++n) {
+    if (std::abs(paintedRatio(n) - 4.0) < std::abs(paintedRatio(some_rows) - 4.0)) some_rows = n;
+  }
+  ASSERT_NEAR(paintedRatio(some_rows), 4.0, 0.4);
   auto run = [&](uint8_t value, int every_nth_row) {
     const cv::Scalar color(value, value, value);
     cv::Mat frame = clean.rgb.clone();
@@ -755,7 +765,7 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
     }
     return white / 100.0;
   };
-  EXPECT_LT(run(240, some_rows), 0.1);
+  EXPECT_LT(run(240, some_rows), 0.3);
   EXPECT_GT(run(255, some_rows), 0.9);
   EXPECT_LT(run(255, 1), 0.1);
 }

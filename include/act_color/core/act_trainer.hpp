@@ -77,7 +77,7 @@ struct ActParams {
   // (off-field samples x remove_stride). A cell whose off-field count exceeds this many times its
   // in-field count is removed whatever its distance from the cluster: the color is more often
   // something else than the class (a spot-lit whitish hall floor next to white). A clipped color
-  // (a channel at 254 or 255) needs ten times the in-field count: a saturated line and a saturated
+  // (a channel at 254 or 255) needs five times the in-field count: a saturated line and a saturated
   // lamp are one color, and after a brightening that clips the lines' cores the hall's clipped
   // pixels can outnumber them. The other way round, a color seen in the field at least twice as
   // often as off it is not removed for lying beyond xi sigma (kEvidenceKeepRatio). 0: off.
