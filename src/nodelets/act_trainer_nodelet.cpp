@@ -1056,6 +1056,11 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("time jumps back", time_jumps_);
   status.add("table revision", trainer_->revision());
   status.add("table fill (%)", fill_percent);
+  const bool yellow_absent = trainer_->goalAbsent(core::kYellow), blue_absent = trainer_->goalAbsent(core::kBlue);
+  status.add("goals taken as absent (colored like the lines)", yellow_absent && blue_absent ? "yellow, blue"
+                                                               : yellow_absent              ? "yellow"
+                                                               : blue_absent                ? "blue"
+                                                                                            : "none");
   for (int k = 1; k < core::kNumClasses; ++k) {
     const core::ClassCluster& c = trainer_->clusters()[k];
     std::ostringstream s;

@@ -885,11 +885,13 @@ TEST_F(ActTrainerTest, AFieldWithoutGoalsLeavesTheLinesWhite) {
     ActTrainer trainer(cal, p);
     trainer.bootstrap(view(without_goals), facing_goal, 20);
     EXPECT_LT((trainer.clusters()[kYellow].mean() - Eigen::Vector3d(wall[0], wall[1], wall[2])).norm(), 30.0);
+    EXPECT_TRUE(trainer.goalAbsent(kYellow) && trainer.goalAbsent(kBlue)) << "seed " << seed;
     EXPECT_EQ(trainer.lut().cellCounts()[kYellow], 0u) << "seed " << seed;
     EXPECT_EQ(trainer.lut().cellCounts()[kBlue], 0u) << "seed " << seed;
     EXPECT_EQ(trainer.lut().classOf(line[0], line[1], line[2]), kWhite) << "seed " << seed;
     ActTrainer control(cal, p);
     control.bootstrap(view(with_goals.rgb), facing_goal, 20);
+    EXPECT_FALSE(control.goalAbsent(kYellow) || control.goalAbsent(kBlue)) << "seed " << seed;
     EXPECT_GT(control.lut().cellCounts()[kYellow], 0u) << "seed " << seed;
     EXPECT_GT(control.lut().cellCounts()[kBlue], 0u) << "seed " << seed;
   }

@@ -210,6 +210,9 @@ class ActTrainer {
 
   const ColorLut& lut() const { return lut_; }
   const std::array<ClassCluster, kNumClasses>& clusters() const { return clusters_; }
+  // A goal (kYellow, kBlue) taken as absent in the last cycle (ActParams::nearest_mean: its mean
+  // lies with white's, as on a field without colored goals).
+  bool goalAbsent(uint8_t k) const { return k < kNumClasses && absent_[k]; }
   // True for a cell mapped by add_neighbourhood_cells that no in-field sample has confirmed yet.
   bool neighbourOnly(uint32_t cell) const { return neighbour_only_.at(cell) != 0; }
   uint64_t revision() const { return revision_; }
