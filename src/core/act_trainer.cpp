@@ -315,7 +315,6 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   dark_frozen_ = false;
   light_states_.clear();
   last_light_change_ = 0;
-  absent_.fill(false);
   restartPoseCheck();  // a table from elsewhere: not yet confirmed here
   space_known_ = true;
 }
@@ -608,7 +607,6 @@ void ActTrainer::prepareNearestMean() {
 }
 
 void ActTrainer::markAbsentGoals(CycleStats& stats) {
-  const bool was_absent[2] = {absent_[kYellow], absent_[kBlue]};
   absent_.fill(false);
   const ClassCluster& green = clusters_[kGreen];
   const ClassCluster& white = clusters_[kWhite];
@@ -617,7 +615,10 @@ void ActTrainer::markAbsentGoals(CycleStats& stats) {
   for (const uint8_t k : {kYellow, kBlue}) {
     absent_[k] = clusters_[k].trained() && (clusters_[k].mean() - white.mean()).norm() < kAbsentGoalFraction * scale;
   }
-  if ((absent_[kYellow] && !was_absent[0]) || (absent_[kBlue] && !was_absent[1])) {
+  // Nothing is added to an absent goal: its cells are those it had when it became absent, or those
+  // of a restored light's or a loaded table.
+  const auto counts = lut_.cellCounts();
+  if ((absent_[kYellow] && counts[kYellow] > 0) || (absent_[kBlue] && counts[kBlue] > 0)) {
     for (uint32_t cell = 0; cell < lut_.size(); ++cell) {
       const uint8_t k = lut_.at(cell);
       if (k < kNumClasses && absent_[k]) {
@@ -746,7 +747,6 @@ bool ActTrainer::restoreLightState() {
   // The light restored keeps its reference and takes this cycle's anchors from the light left.
   light_.adoptObservation(best->light);
   rebuildMapped();
-  absent_.fill(false);  // the restored table may hold an absent goal's cells: cleared again
   ball_hypotheses_.clear();
   return true;
 }
