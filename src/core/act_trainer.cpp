@@ -268,6 +268,7 @@ void ActTrainer::reset(ColorSpace space) {
   light_.reset();
   dark_position_ = -1;
   dark_frozen_ = false;
+  carpet_spread_ = -1;
   light_states_.clear();
   last_light_change_ = 0;
   restartPoseCheck();
@@ -563,7 +564,29 @@ uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3], double dark_limi
   const int hi = std::max({c[0], c[1], c[2]});
   if (hi - lo > 0.35 * hi + 8) return k;
   const Eigen::Vector3d color(c[0], c[1], c[2]);
-  return (color - green.mean()).norm() > params_.zeta * green.sigma() ? static_cast<uint8_t>(kBlack) : k;
+  // Far from the carpet: beyond zeta times its own spread (green's sigma when that is smaller).
+  const double sigma = carpet_spread_ > 0 ? std::min(green.sigma(), carpet_spread_) : green.sigma();
+  return (color - green.mean()).norm() > params_.zeta * sigma ? static_cast<uint8_t>(kBlack) : k;
+}
+
+void ActTrainer::measureCarpetSpread() {
+  // Green's sigma (eq. 5) is the spread of every sample the pose expects green, robots and mirror
+  // struts standing on the carpet among them: where they are many, sigma grows until they lie
+  // within zeta sigma of green and never train black, a fixed point (a scene with four struts and
+  // dark robots: green's sigma 55 where the carpet's own spread is some 15, black F1 0.10 where a
+  // fixed table reaches 0.94). The carpet's spread is robust to them: the median distance of this
+  // cycle's carpet samples from green's mean, times 1.12 (the RMS distance of a 3-D normal spread
+  // over its median, as eq. 5's sigma is an RMS distance).
+  carpet_spread_ = -1;
+  constexpr size_t kMinCarpetSamples = 20;
+  if (carpet_samples_.size() < kMinCarpetSamples || !clusters_[kGreen].trained()) return;
+  carpet_distances_.clear();
+  const Eigen::Vector3f mean = clusters_[kGreen].mean().cast<float>();
+  for (const Eigen::Vector3f& c : carpet_samples_) carpet_distances_.push_back((c - mean).norm());
+  const auto middle = carpet_distances_.begin() + static_cast<long>(carpet_distances_.size() / 2);
+  std::nth_element(carpet_distances_.begin(), middle, carpet_distances_.end());
+  constexpr double kRmsOverMedianDistance = 1.12;
+  carpet_spread_ = std::max(kRmsOverMedianDistance * *middle, params_.sigma_min);
 }
 
 double ActTrainer::darkLimit() const {
@@ -976,6 +999,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     stats.cluster_samples[k] = static_cast<uint32_t>(samples_[k].size());
   }
 
+  measureCarpetSpread();
   markAbsentGoals(stats);
   if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.

@@ -63,9 +63,10 @@ struct ActParams {
   double robot_height_m = 0.8;
   // Black is the own chassis and the other robots, but the chassis alone is lit differently from
   // robots elsewhere on the field: a color expected green or a goal that is far from green (beyond
-  // zeta * sigma), dark (intensity below 60% of green's in the light before the first change, a
-  // limit carried through changes by its place between the own chassis and the carpet) and
-  // unsaturated is a robot standing on the carpet or in front of a goal and trains black instead.
+  // zeta times the carpet's own spread, which the robots and struts on it do not widen), dark
+  // (intensity below 60% of green's in the light before the first change, a limit carried through
+  // changes by its place between the own chassis and the carpet) and unsaturated is a robot
+  // standing on the carpet or in front of a goal and trains black instead.
   bool robots_train_black = true;
   // A color joins class k only when k's cluster mean is the nearest of the trained clusters'
   // means: the table splits mixed colors (the blurred edge of a line on the carpet) where they are
@@ -247,6 +248,8 @@ class ActTrainer {
   // The own chassis's colors (chassis_samples_, an anchor of the light model) and their median
   // intensity, robots_train_black's black of this light.
   void measureChassis(const ImageView& image);
+  // robots_train_black's scale of "far from green": the carpet's own spread this cycle.
+  void measureCarpetSpread();
   // Light compensation (after 2.2's samples, before the clusters move): observes the anchors, and
   // when the carpet's median moved, takes a closer look (`look_closer` fills anchor_samples_ with
   // this frame's carpet and line colors) and restores a kept light or moves the table.
@@ -315,7 +318,7 @@ class ActTrainer {
   double boundary_t_ = 0.5;
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
-  std::vector<Eigen::Vector3f> carpet_samples_;   // expected green, before robots_train_black: an anchor
+  std::vector<Eigen::Vector3f> carpet_samples_;   // expected green, before robots_train_black: an anchor, the spread
   std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> anchor_samples_;  // scratch of a denser look
   std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, about 192
@@ -324,6 +327,10 @@ class ActTrainer {
   // darkLimit's position between the chassis (0) and the carpet (1), taken until the first change
   // of light; -1 unset.
   double dark_position_ = -1;
+  // robots_train_black's spread of the carpet (measureCarpetSpread; -1: not measured) and its
+  // scratch.
+  double carpet_spread_ = -1;
+  std::vector<float> carpet_distances_;
   bool dark_frozen_ = false;
   LightModel light_;
   std::vector<uint8_t> warped_;
