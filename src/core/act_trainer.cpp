@@ -574,19 +574,21 @@ void ActTrainer::measureCarpetSpread() {
   // struts standing on the carpet among them: where they are many, sigma grows until they lie
   // within zeta sigma of green and never train black, a fixed point (a scene with four struts and
   // dark robots: green's sigma 55 where the carpet's own spread is some 15, black F1 0.10 where a
-  // fixed table reaches 0.94). The carpet's spread is robust to them: the median distance of this
-  // cycle's carpet samples from green's mean, times 1.12 (the RMS distance of a 3-D normal spread
-  // over its median, as eq. 5's sigma is an RMS distance).
+  // fixed table reaches 0.94). The carpet's spread is robust to them while they are less than a
+  // quarter of its samples: the upper quartile of this cycle's carpet samples' distances from
+  // green's mean, times 0.854 (a 3-D normal spread's RMS distance over its upper quartile; eq. 5's
+  // sigma is an RMS distance). The median instead moved the family's figures alike but made more
+  // of the real cameras' dark hall (the mirror's mount) black.
   carpet_spread_ = -1;
   constexpr size_t kMinCarpetSamples = 20;
   if (carpet_samples_.size() < kMinCarpetSamples || !clusters_[kGreen].trained()) return;
   carpet_distances_.clear();
   const Eigen::Vector3f mean = clusters_[kGreen].mean().cast<float>();
   for (const Eigen::Vector3f& c : carpet_samples_) carpet_distances_.push_back((c - mean).norm());
-  const auto middle = carpet_distances_.begin() + static_cast<long>(carpet_distances_.size() / 2);
-  std::nth_element(carpet_distances_.begin(), middle, carpet_distances_.end());
-  constexpr double kRmsOverMedianDistance = 1.12;
-  carpet_spread_ = std::max(kRmsOverMedianDistance * *middle, params_.sigma_min);
+  const auto upper_quartile = carpet_distances_.begin() + static_cast<long>(carpet_distances_.size() * 3 / 4);
+  std::nth_element(carpet_distances_.begin(), upper_quartile, carpet_distances_.end());
+  constexpr double kRmsOverUpperQuartileDistance = 0.854;
+  carpet_spread_ = std::max(kRmsOverUpperQuartileDistance * *upper_quartile, params_.sigma_min);
 }
 
 double ActTrainer::darkLimit() const {
