@@ -39,8 +39,8 @@ void expectHolds(const sim::RealImageResult& r) {
     EXPECT_GE(row.before.white_recall, 0.50) << row.variant;
     EXPECT_GE(row.before.green_recall, 0.88) << row.variant;
     EXPECT_LE(row.before.hall_in_field, 0.15) << row.variant;
-    // Nor does black take the hall (a robot's class, counted apart; measured 0.10 on nubot_1 and
-    // 0.03 on nubot_1_bak_bak).
+    // Nor does black take the hall (a robot's class, counted apart; measured 0.12 on nubot_1 and
+    // 0.08 on nubot_1_bak_bak, 0.10 and 0.04 before robots_train_black's carpet spread).
     EXPECT_LE(row.before.hall_as_black, 0.15) << row.variant;
     // The look at the image after the change (act_real_eval --png): the last frame and its labels.
     ASSERT_EQ(row.frame_last.size(), row.labels_last.size()) << row.variant;
