@@ -581,7 +581,9 @@ void ActTrainer::measureCarpetSpread() {
   // of the real cameras' dark hall (the mirror's mount) black.
   carpet_spread_ = -1;
   constexpr size_t kMinCarpetSamples = 20;
-  if (carpet_samples_.size() < kMinCarpetSamples || !clusters_[kGreen].trained()) return;
+  if (!params_.robots_train_black || carpet_samples_.size() < kMinCarpetSamples || !clusters_[kGreen].trained()) {
+    return;
+  }
   carpet_distances_.clear();
   const Eigen::Vector3f mean = clusters_[kGreen].mean().cast<float>();
   for (const Eigen::Vector3f& c : carpet_samples_) carpet_distances_.push_back((c - mean).norm());

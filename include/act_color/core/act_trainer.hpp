@@ -327,11 +327,11 @@ class ActTrainer {
   // darkLimit's position between the chassis (0) and the carpet (1), taken until the first change
   // of light; -1 unset.
   double dark_position_ = -1;
+  bool dark_frozen_ = false;
   // robots_train_black's spread of the carpet (measureCarpetSpread; -1: not measured) and its
   // scratch.
   double carpet_spread_ = -1;
   std::vector<float> carpet_distances_;
-  bool dark_frozen_ = false;
   LightModel light_;
   std::vector<uint8_t> warped_;
   // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.
