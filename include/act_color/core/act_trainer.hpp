@@ -64,9 +64,11 @@ struct ActParams {
   // Black is the own chassis and the other robots, but the chassis alone is lit differently from
   // robots elsewhere on the field: a color expected green or a goal that is far from green (beyond
   // zeta times the carpet's own spread, which the robots and struts on it do not widen), dark
-  // (intensity below 60% of green's in the light before the first change, a limit carried through
+  // (intensity below 80% of green's in the light before the first change, a limit carried through
   // changes by its place between the own chassis and the carpet) and unsaturated is a robot
-  // standing on the carpet or in front of a goal and trains black instead.
+  // standing on the carpet or in front of a goal and trains black instead. A color expected in a
+  // goal with less than half the carpet's chroma (grey beside it: a robot or a person in front of
+  // the goal) trains no goal.
   bool robots_train_black = true;
   // A color joins class k only when k's cluster mean is the nearest of the trained clusters'
   // means: the table splits mixed colors (the blurred edge of a line on the carpet) where they are
@@ -250,6 +252,10 @@ class ActTrainer {
   void measureChassis(const ImageView& image);
   // robots_train_black's scale of "far from green": the carpet's own spread this cycle.
   void measureCarpetSpread();
+  // robots_train_black's least chroma of a goal's color, of the carpet's color this cycle.
+  void measureCarpetColor();
+  // False for a color of a goal sample (k yellow or blue) that is no goal's color.
+  bool goalColor(uint8_t k, const Eigen::Vector3f& c) const;
   // Light compensation (after 2.2's samples, before the clusters move): observes the anchors, and
   // when the carpet's median moved, takes a closer look (`look_closer` fills anchor_samples_ with
   // this frame's carpet and line colors) and restores a kept light or moves the table.
@@ -318,7 +324,8 @@ class ActTrainer {
   double boundary_t_ = 0.5;
   // Per-cycle scratch, kept to avoid allocations.
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> samples_;
-  std::vector<Eigen::Vector3f> carpet_samples_;   // expected green, before robots_train_black: an anchor, the spread
+  // Expected green, before robots_train_black: an anchor, the carpet's spread and color.
+  std::vector<Eigen::Vector3f> carpet_samples_;
   std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> anchor_samples_;  // scratch of a denser look
   std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, about 192
@@ -332,6 +339,7 @@ class ActTrainer {
   // scratch.
   double carpet_spread_ = -1;
   std::vector<float> carpet_distances_;
+  double goal_min_chroma_ = 0;  // goalColor's least chroma, of this cycle's carpet (measureCarpetColor)
   LightModel light_;
   std::vector<uint8_t> warped_;
   // Cycle (revision) in which each cell was last confirmed by an in-field sample of its class.
