@@ -42,6 +42,36 @@ class ActTrainerTest : public ::testing::Test {
   Pose2D pose{2.0, 1.0, 0.4};
   // The paper's wrong pose (3.3): 2.5 m from `pose`, rotated by 165 degrees.
   Pose2D wrongPose() const { return act_color::sim::wrongPose(pose, 2.0); }
+  // The color of a 580x580 frame painted at `at` where the model expects class k (the last such
+  // pixel in raster order).
+  cv::Vec3b colorOf(const cv::Mat& rgb, const Pose2D& at, uint8_t k) const {
+    const PoseTransform t(at);
+    for (int i = 580 * 580 - 1; i >= 0; --i) {
+      if (model.geometricClass(i, t) == k) return rgb.at<cv::Vec3b>(i / 580, i % 580);
+    }
+    return cv::Vec3b(0, 0, 0);
+  }
+  // Paints `color` (truth kBlack) over the pixels expected as class k whose bearing around the
+  // mirror's centre lies in the first `width_deg` of every `period_deg`, as robots and struts
+  // near the robot are. Returns the pixels expected as k and those painted.
+  std::pair<int, int> paintWedges(act_color::sim::LabeledFrame& frame, const Pose2D& at, uint8_t k, double period_deg,
+                                  double width_deg, const cv::Vec3b& color) const {
+    const PoseTransform t(at);
+    int expected = 0, painted = 0;
+    for (int v = 0; v < 580; ++v) {
+      for (int u = 0; u < 580; ++u) {
+        if (model.geometricClass(v * 580 + u, t) != k) continue;
+        ++expected;
+        const double bearing = std::atan2(v - 290.0, u - 290.0) + M_PI;
+        if (std::fmod(bearing * 180.0 / M_PI, period_deg) < width_deg) {
+          frame.rgb.at<cv::Vec3b>(v, u) = color;
+          frame.labels.at<uint8_t>(v, u) = kBlack;
+          ++painted;
+        }
+      }
+    }
+    return {expected, painted};
+  }
 };
 
 }  // namespace
@@ -917,31 +947,10 @@ TEST_F(ActTrainerTest, RobotsCoveringMuchOfTheCarpetStillTrainBlack) {
   // green's sigma they never train black (sigma 40, black recall 0.14 in two of the three seeds).
   // Against the carpet's own spread, which they do not widen, they do (green's sigma then 7).
   auto frame = paintFlatFrame(model, pose, 1.0, 1);
-  const PoseTransform t(pose);
-  cv::Vec3b chassis(0, 0, 0), carpet(0, 0, 0);
-  for (int v = 0; v < 580; ++v) {
-    for (int u = 0; u < 580; ++u) {
-      const uint8_t k = model.geometricClass(v * 580 + u, t);
-      if (k == kBlack) chassis = frame.rgb.at<cv::Vec3b>(v, u);
-      if (k == kGreen) carpet = frame.rgb.at<cv::Vec3b>(v, u);
-    }
-  }
+  const cv::Vec3b chassis = colorOf(frame.rgb, pose, kBlack), carpet = colorOf(frame.rgb, pose, kGreen);
   const auto lift = [](uint8_t c) { return static_cast<uint8_t>(std::min(255, c + 13)); };
   const cv::Vec3b robot(lift(chassis[0]), lift(chassis[1]), lift(chassis[2]));
-  int green_pixels = 0, covered = 0;
-  for (int v = 0; v < 580; ++v) {
-    for (int u = 0; u < 580; ++u) {
-      if (model.geometricClass(v * 580 + u, t) != kGreen) continue;
-      ++green_pixels;
-      // Wedges of bearings around the mirror's centre, as struts and robots near the robot are.
-      const double bearing = std::atan2(v - 290.0, u - 290.0) + M_PI;
-      if (std::fmod(bearing * 180.0 / M_PI, 36.0) < 7.2) {
-        frame.rgb.at<cv::Vec3b>(v, u) = robot;
-        frame.labels.at<uint8_t>(v, u) = kBlack;
-        ++covered;
-      }
-    }
-  }
+  const auto [green_pixels, covered] = paintWedges(frame, pose, kGreen, 36.0, 7.2, robot);
   ASSERT_GT(covered, green_pixels / 6);
   ASSERT_LT(covered, green_pixels / 4);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
@@ -965,30 +974,10 @@ TEST_F(ActTrainerTest, AGoalMostlyHiddenByGreyRobotsKeepsItsColor) {
   // grey beside the carpet: they train no goal.
   const Pose2D facing_goal{1.0, 0.3, 0.2};
   auto frame = paintFlatFrame(model, facing_goal, 1.0, 1);
-  const PoseTransform t(facing_goal);
-  cv::Vec3b carpet(0, 0, 0), goal(0, 0, 0);
-  for (int v = 0; v < 580; ++v) {
-    for (int u = 0; u < 580; ++u) {
-      const uint8_t k = model.geometricClass(v * 580 + u, t);
-      if (k == kGreen) carpet = frame.rgb.at<cv::Vec3b>(v, u);
-      if (k == kYellow) goal = frame.rgb.at<cv::Vec3b>(v, u);
-    }
-  }
+  const cv::Vec3b carpet = colorOf(frame.rgb, facing_goal, kGreen), goal = colorOf(frame.rgb, facing_goal, kYellow);
   const uint8_t level = static_cast<uint8_t>((carpet[0] + carpet[1] + carpet[2]) / 3);
   const cv::Vec3b robot(level, level, level);
-  int goal_pixels = 0, covered = 0;
-  for (int v = 0; v < 580; ++v) {
-    for (int u = 0; u < 580; ++u) {
-      if (model.geometricClass(v * 580 + u, t) != kYellow) continue;
-      ++goal_pixels;
-      const double bearing = std::atan2(v - 290.0, u - 290.0) + M_PI;
-      if (std::fmod(bearing * 180.0 / M_PI, 4.0) < 3.2) {
-        frame.rgb.at<cv::Vec3b>(v, u) = robot;
-        frame.labels.at<uint8_t>(v, u) = kBlack;
-        ++covered;
-      }
-    }
-  }
+  const auto [goal_pixels, covered] = paintWedges(frame, facing_goal, kYellow, 4.0, 3.2, robot);
   ASSERT_GT(goal_pixels, 500);
   ASSERT_GT(covered, goal_pixels * 7 / 10);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
