@@ -628,8 +628,8 @@ void ActTrainer::measureCarpetColor() {
 double ActTrainer::darkLimit() const {
   // 80% of the carpet's intensity in the light before the first change, as a position between the
   // own chassis and the carpet (which a change of gain, brightness and contrast keeps): the paper's
-  // darkening lifts black, and at a fraction of green's intensity alone no robot trained black after it
-  // (tuning scenes 10, 70, 73).
+  // darkening lifts black, and at a fraction of green's intensity alone no robot trained black
+  // after it (tuning scenes 10, 70, 73).
   const double green = clusters_[kGreen].mean().sum();
   if (!(dark_position_ >= 0) || green - chassis_intensity_ < kMinAnchorSpan) return kDarkFraction * green;
   return chassis_intensity_ + dark_position_ * (green - chassis_intensity_);
