@@ -598,11 +598,11 @@ void ActTrainer::measureCarpetSpread() {
   if (!params_.robots_train_black || carpet_samples_.size() < kMinCarpetSamples || !clusters_[kGreen].trained()) {
     return;
   }
-  carpet_distances_.clear();
+  carpet_values_.clear();
   const Eigen::Vector3f mean = clusters_[kGreen].mean().cast<float>();
-  for (const Eigen::Vector3f& c : carpet_samples_) carpet_distances_.push_back((c - mean).norm());
-  const auto upper_quartile = carpet_distances_.begin() + static_cast<long>(carpet_distances_.size() * 3 / 4);
-  std::nth_element(carpet_distances_.begin(), upper_quartile, carpet_distances_.end());
+  for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back((c - mean).norm());
+  const auto upper_quartile = carpet_values_.begin() + static_cast<long>(carpet_values_.size() * 3 / 4);
+  std::nth_element(carpet_values_.begin(), upper_quartile, carpet_values_.end());
   constexpr double kRmsOverUpperQuartileDistance = 0.854;
   carpet_spread_ = std::max(kRmsOverUpperQuartileDistance * *upper_quartile, params_.sigma_min);
 }
@@ -616,10 +616,10 @@ void ActTrainer::measureCarpetColor() {
   if (!params_.robots_train_black || carpet_samples_.size() < kMinCarpetSamples) return;
   Eigen::Vector3f median;
   for (int ch = 0; ch < 3; ++ch) {
-    carpet_distances_.clear();
-    for (const Eigen::Vector3f& c : carpet_samples_) carpet_distances_.push_back(c[ch]);
-    const auto middle = carpet_distances_.begin() + static_cast<long>(carpet_distances_.size() / 2);
-    std::nth_element(carpet_distances_.begin(), middle, carpet_distances_.end());
+    carpet_values_.clear();
+    for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back(c[ch]);
+    const auto middle = carpet_values_.begin() + static_cast<long>(carpet_values_.size() / 2);
+    std::nth_element(carpet_values_.begin(), middle, carpet_values_.end());
     median[ch] = *middle;
   }
   goal_min_chroma_ = kGoalMinChromaOfCarpet * chroma(median, lut_.colorSpace());
@@ -918,7 +918,7 @@ template <class LookCloser>
 void ActTrainer::followLight(LookCloser&& look_closer, CycleStats& stats) {
   // The anchors of the light model (before any class filters its colors): carpet and lines from
   // the cluster samples, the chassis densely. The carpet as the pose expects it, before
-  // robots_train_black: the paper's darkening takes the carpet below 60% of green's intensity,
+  // robots_train_black: the paper's darkening takes the carpet below the dark limit (darkLimit),
   // where all of it would train black, and the change went unseen for 4 frames (tuning seed 20).
   // The chassis's colors are measureChassis's.
   light_.observe(carpet_samples_, samples_[kWhite], chassis_samples_);
@@ -1029,9 +1029,11 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
         stats);
   }
   measureCarpetColor();
-  for (const uint8_t k : {kYellow, kBlue}) {
-    auto& s = samples_[k];
-    s.erase(std::remove_if(s.begin(), s.end(), [&](const Eigen::Vector3f& c) { return !goalColor(k, c); }), s.end());
+  if (goal_min_chroma_ > 0) {  // 0: not measured, every color may be a goal's
+    for (const uint8_t k : {kYellow, kBlue}) {
+      auto& s = samples_[k];
+      s.erase(std::remove_if(s.begin(), s.end(), [&](const Eigen::Vector3f& c) { return !goalColor(k, c); }), s.end());
+    }
   }
   const ClusterParams cluster_params = clusterParams();
   if (poseContradicted(stats)) {

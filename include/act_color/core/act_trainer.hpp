@@ -335,10 +335,10 @@ class ActTrainer {
   // of light; -1 unset.
   double dark_position_ = -1;
   bool dark_frozen_ = false;
-  // robots_train_black's spread of the carpet (measureCarpetSpread; -1: not measured) and its
-  // scratch.
+  // robots_train_black's spread of the carpet (measureCarpetSpread; -1: not measured), and the
+  // scratch of its measurements (the samples' distances, one channel of their colors).
   double carpet_spread_ = -1;
-  std::vector<float> carpet_distances_;
+  std::vector<float> carpet_values_;
   double goal_min_chroma_ = 0;  // goalColor's least chroma, of this cycle's carpet (measureCarpetColor)
   LightModel light_;
   std::vector<uint8_t> warped_;
