@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "act_color/core/segmenter.hpp"
 #include "act_color/sim/tone_curve.hpp"
@@ -65,31 +66,55 @@ std::vector<double> exposureSwing(size_t count, size_t first, double amplitude, 
 }
 
 const std::vector<double>& steadyReferenceGains() {
-  static const std::vector<double> gains = {0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3};
+  // Every 0.025: a frame is compared with a light at most 0.0125 from its own. At every 0.1, the
+  // frames of an exposure alternating between 0.856 and 1.144 were compared with steady runs at 0.9
+  // and 1.1, whose white precision differs by up to 0.04 from runs at their own gains (tuning
+  // scene 3), more than the target allows; the controls (fresh noise) differ by at most 0.015.
+  static const std::vector<double> gains = [] {
+    std::vector<double> g;
+    for (int i = 0; i <= 24; ++i) g.push_back(0.7 + 0.025 * i);
+    return g;
+  }();
   return gains;
 }
 
+int steadyReferenceFor(double gain) {
+  if (!(gain >= 0.65 && gain <= 1.35)) return -1;
+  const std::vector<double>& levels = steadyReferenceGains();
+  size_t best = 0;
+  for (size_t l = 1; l < levels.size(); ++l) {
+    if (std::abs(levels[l] - gain) < std::abs(levels[best] - gain)) best = l;
+  }
+  return static_cast<int>(best);
+}
+
 std::vector<FlickerRun> playSteadyReferences(const FamilyScene& scene, const FlickerFrames& frames,
-                                             const core::ActParams& params) {
-  std::vector<FlickerRun> references;
-  for (const double gain : steadyReferenceGains()) {
-    references.push_back(playWithGains(scene, frames, std::vector<double>(frames.frames.size(), gain), params));
+                                             const core::ActParams& params, const std::vector<double>* compared_gains) {
+  const std::vector<double>& levels = steadyReferenceGains();
+  std::vector<bool> needed(levels.size(), compared_gains == nullptr);
+  if (compared_gains != nullptr) {
+    for (const double gain : *compared_gains) {
+      const int l = steadyReferenceFor(gain);
+      if (l >= 0) needed[static_cast<size_t>(l)] = true;
+    }
+  }
+  std::vector<FlickerRun> references(levels.size());
+  for (size_t l = 0; l < levels.size(); ++l) {
+    if (needed[l])
+      references[l] = playWithGains(scene, frames, std::vector<double>(frames.frames.size(), levels[l]), params);
   }
   return references;
 }
 
 FlickerComparison compareWithSteadyLight(const FlickerRun& run, const std::vector<double>& gains,
                                          const std::vector<FlickerRun>& references, size_t first) {
-  const std::vector<double>& levels = steadyReferenceGains();
   FlickerComparison out;
   int compared = 0;
   for (size_t i = first; i < run.fill.size(); ++i) {
-    if (gains[i] < 0.65 || gains[i] > 1.35) continue;
-    size_t best = 0;
-    for (size_t l = 1; l < levels.size(); ++l) {
-      if (std::abs(levels[l] - gains[i]) < std::abs(levels[best] - gains[i])) best = l;
-    }
-    const FlickerRun& reference = references[best];
+    const int level = steadyReferenceFor(gains[i]);
+    if (level < 0) continue;
+    const FlickerRun& reference = references.at(static_cast<size_t>(level));
+    if (reference.fill.size() <= i) throw std::invalid_argument("no steady reference played for this gain");
     const double ratio = run.fill[i] / std::max(reference.fill[i], 1e-9);
     out.fill_max_ratio = std::max(out.fill_max_ratio, ratio);
     out.fill_mean_ratio += ratio;

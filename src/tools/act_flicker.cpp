@@ -2,7 +2,7 @@
 // seeds given, its motion with the first frame's light frozen, played with every other frame at
 // half brightness, one frame in ten at half, and an exposure swinging 1 +- 0.3 at 1, 2, 5 and
 // 15 Hz (30 frames per second); each against light-matched steady runs (the nearest of the gains
-// 0.7 ... 1.3, trained from the start at that light): the table's largest fill over the reference's
+// 0.7, 0.725, ... 1.3, trained from the start at that light): the table's largest fill over the reference's
 // on the same frame, and the largest precision drop of a class on the compared frames. A control row
 // per scene measures the same way a steady run at full light on another realisation of the sensor
 // noise: how far two runs without any flicker differ by chance (not counted in the summary's runs).

@@ -35,7 +35,7 @@ std::vector<double> everyNthFrame(size_t count, int period, double gain);
 std::vector<double> exposureSwing(size_t count, size_t first, double amplitude, double hz);
 
 // A run against light-matched references: for each frame from `first` on whose gain is within
-// [0.65, 1.35], the steady run at the nearest of the gains 0.7, 0.8, ..., 1.3 (trained from the start
+// [0.65, 1.35], the steady run at the nearest of the gains 0.7, 0.725, ..., 1.3 (trained from the start
 // at that light; frames at other gains, the dark frames of a flicker, are not compared).
 struct FlickerComparison {
   double fill_max_ratio = 0;                   // largest fill / the reference's fill on the same frame
@@ -48,9 +48,14 @@ FlickerComparison compareWithSteadyLight(const FlickerRun& run, const std::vecto
                                          const std::vector<FlickerRun>& references, size_t first);
 // The gains of the references compareWithSteadyLight expects, in its order.
 const std::vector<double>& steadyReferenceGains();
-// Those references: the frames played at each of those gains throughout.
+// The index in steadyReferenceGains() of the reference a frame at `gain` is compared with; -1 for a
+// gain outside [0.65, 1.35] (not compared).
+int steadyReferenceFor(double gain);
+// Those references: the frames played at each of those gains throughout. Only the references that
+// frames at `compared_gains` are compared with when given (the others stay empty).
 std::vector<FlickerRun> playSteadyReferences(const FamilyScene& scene, const FlickerFrames& frames,
-                                             const core::ActParams& params = core::ActParams());
+                                             const core::ActParams& params = core::ActParams(),
+                                             const std::vector<double>* compared_gains = nullptr);
 
 }  // namespace sim
 }  // namespace act_color
