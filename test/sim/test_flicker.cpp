@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 #include <vector>
 
 #include "act_color/core/metrics.hpp"
@@ -131,7 +132,8 @@ TEST(FlickerSlowSwing, AnExposureSwingingSlowlyIsServedByTheLightsItLeft) {
 // measured as act_flicker measures it (against the steady runs at the nearest of 0.7, 0.725, ... 1.3,
 // the compared frames pooled): every class's precision within 0.03 (issue 15, item 1). The map of
 // the first change went through the lines' quantiles as seen, which a view of other lines had
-// moved, and white fell 0.071 below; fitted with a curve of light's form, 0.015.
+// moved, and white fell 0.071 below; fitted with a curve of light's form, 0.015 (0.012 against
+// references every 0.025 of gain instead of 0.1).
 TEST(FlickerFastSwing, AnExposureAlternatingEveryFrameKeepsThePrecision) {
   const sim::FamilyScene scene = sim::makeFamilyScene(5, sim::ScenarioLength::kSmall, false);
   const sim::FlickerFrames frames = sim::steadyLightFrames(scene, 120);
@@ -143,6 +145,29 @@ TEST(FlickerFastSwing, AnExposureAlternatingEveryFrameKeepsThePrecision) {
               c.worst_precision_drop, core::className(c.worst_class), c.fill_max_ratio);
   EXPECT_LE(c.worst_precision_drop, 0.03) << core::className(c.worst_class);
   EXPECT_LE(c.fill_max_ratio, 1.5);
+}
+
+// A frame is compared with the steady run nearest to its gain, at most 0.0125 away; gains outside
+// [0.65, 1.35] (a flicker's dark frames) are not compared, and a comparison without the reference it
+// needs is refused rather than made against nothing.
+TEST(FlickerReferences, EachFrameMeetsTheSteadyRunNearestToItsLight) {
+  const std::vector<double>& levels = sim::steadyReferenceGains();
+  for (const double gain : {0.7, 0.856, 1.0, 1.144, 1.3, 0.66, 1.34}) {
+    const int l = sim::steadyReferenceFor(gain);
+    ASSERT_GE(l, 0) << gain;
+    const double off = std::abs(levels[static_cast<size_t>(l)] - gain);
+    EXPECT_LE(off, gain >= 0.7 && gain <= 1.3 ? 0.0125 + 1e-9 : 0.05) << gain;
+  }
+  EXPECT_EQ(sim::steadyReferenceFor(0.5), -1);
+  EXPECT_EQ(sim::steadyReferenceFor(1.4), -1);
+  EXPECT_EQ(sim::steadyReferenceFor(std::nan("")), -1);
+
+  sim::FlickerRun run;
+  run.fill = {0.01, 0.01};
+  run.per_frame.resize(2);
+  const std::vector<sim::FlickerRun> none(levels.size());
+  EXPECT_THROW(sim::compareWithSteadyLight(run, {1.0, 1.0}, none, 0), std::invalid_argument);
+  EXPECT_NO_THROW(sim::compareWithSteadyLight(run, {0.5, 0.5}, none, 0));  // nothing to compare
 }
 
 }  // namespace
