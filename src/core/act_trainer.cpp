@@ -584,6 +584,10 @@ uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3], double dark_limi
   return (color - green.mean()).norm() > params_.zeta * sigma ? static_cast<uint8_t>(kBlack) : k;
 }
 
+bool ActTrainer::carpetMeasurable() const {
+  return params_.robots_train_black && carpet_samples_.size() >= kMinCarpetSamples;
+}
+
 void ActTrainer::measureCarpetSpread() {
   // Green's sigma (eq. 5) is the spread of every sample the pose expects green, robots and mirror
   // struts standing on the carpet among them: where they are many, sigma grows until they lie
@@ -595,9 +599,7 @@ void ActTrainer::measureCarpetSpread() {
   // sigma is an RMS distance). The median instead moved the family's figures alike but made more
   // of the real cameras' dark hall (the mirror's mount) black.
   carpet_spread_ = -1;
-  if (!params_.robots_train_black || carpet_samples_.size() < kMinCarpetSamples || !clusters_[kGreen].trained()) {
-    return;
-  }
+  if (!carpetMeasurable() || !clusters_[kGreen].trained()) return;
   carpet_values_.clear();
   const Eigen::Vector3f mean = clusters_[kGreen].mean().cast<float>();
   for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back((c - mean).norm());
@@ -613,7 +615,7 @@ void ActTrainer::measureCarpetColor() {
   // of the lines' color, and trains no goal. Where robots hid most of a goal, its cluster took
   // their grey (fresh seed 2026: yellow F1 0.10, a fixed table's 0.99).
   goal_min_chroma_ = 0;
-  if (!params_.robots_train_black || carpet_samples_.size() < kMinCarpetSamples) return;
+  if (!carpetMeasurable()) return;
   Eigen::Vector3f median;
   for (int ch = 0; ch < 3; ++ch) {
     carpet_values_.clear();

@@ -250,6 +250,8 @@ class ActTrainer {
   // The own chassis's colors (chassis_samples_, an anchor of the light model) and their median
   // intensity, robots_train_black's black of this light.
   void measureChassis(const ImageView& image);
+  // robots_train_black's measurements of the carpet need it on and enough of this cycle's samples.
+  bool carpetMeasurable() const;
   // robots_train_black's scale of "far from green": the carpet's own spread this cycle.
   void measureCarpetSpread();
   // robots_train_black's least chroma of a goal's color, of the carpet's color this cycle.
