@@ -148,6 +148,11 @@ CameraCalibration parseCamera(MapReader camera) {
     const auto pair = numberSequence(camera, map.items[i], entry_key, 2);
     c.elevation_map.emplace_back(pair[0], pair[1]);
   }
+  if (camera.has("tilt")) {
+    const auto tilt = numberSequence(camera, camera.child("tilt"), camera.key("tilt"), 2);
+    c.tilt_x_rad = tilt[0];
+    c.tilt_y_rad = tilt[1];
+  }
   if (camera.has("self_mask")) {
     const YamlNode& n = camera.child("self_mask");
     if (!n.isScalar() || n.scalar.empty() || n.scalar.find_first_of("\"\\\n") != std::string::npos)
@@ -275,6 +280,9 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
   if (!(c.chassis_radius_px < c.mirror_radius_px)) {
     fail(source, "camera.chassis_radius_px", "must be smaller than camera.mirror_radius_px");
   }
+  if (!(std::hypot(c.tilt_x_rad, c.tilt_y_rad) <= kMaxTiltRad)) {
+    fail(source, "camera.tilt", "must be finite and at most " + std::to_string(kMaxTiltRad) + " rad from the vertical");
+  }
   if (c.elevation_map.size() < 2) fail(source, "camera.elevation_map", "needs at least two entries");
   for (size_t i = 0; i < c.elevation_map.size(); ++i) {
     const auto& [r, e] = c.elevation_map[i];
@@ -358,6 +366,7 @@ std::string toYaml(const Calibration& calibration) {
     << "  mirror_radius_px: " << c.mirror_radius_px << "\n"
     << "  elevation_map:\n";
   for (const auto& [r, e] : c.elevation_map) s << "    - [" << r << ", " << e << "]\n";
+  if (c.tilt_x_rad != 0 || c.tilt_y_rad != 0) s << "  tilt: [" << c.tilt_x_rad << ", " << c.tilt_y_rad << "]\n";
   if (!c.self_mask_file.empty()) s << "  self_mask: \"" << c.self_mask_file << "\"\n";
   s << "field:\n"
     << "  length_m: " << f.length_m << "\n"

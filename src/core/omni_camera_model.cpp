@@ -1,5 +1,6 @@
 #include "act_color/core/omni_camera_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -7,6 +8,9 @@ namespace act_color {
 namespace core {
 
 OmniCameraModel::OmniCameraModel(const CameraCalibration& camera) : camera_(camera) {
+  const Eigen::Vector3d tilt(camera_.tilt_x_rad, camera_.tilt_y_rad, 0.0);
+  tilted_ = tilt.norm() > 0;
+  if (tilted_) tilt_ = Eigen::AngleAxisd(tilt.norm(), tilt.normalized()).toRotationMatrix();
   rays_.resize(static_cast<size_t>(camera_.width) * camera_.height);
   for (int v = 0; v < camera_.height; ++v) {
     for (int u = 0; u < camera_.width; ++u) rays_[static_cast<size_t>(v) * camera_.width + u] = computeRay(u, v);
@@ -55,8 +59,14 @@ PixelRay OmniCameraModel::computeRay(double u, double v) const {
     ray.region = PixelRegion::kChassis;
     return ray;
   }
-  const double elevation = elevationAtRadius(r);
-  const double bearing = camera_.bearing_sign * std::atan2(dv, du) + camera_.bearing_offset_rad;
+  double elevation = elevationAtRadius(r);
+  double bearing = camera_.bearing_sign * std::atan2(dv, du) + camera_.bearing_offset_rad;
+  if (tilted_) {
+    const Eigen::Vector3d dir = tilt_ * Eigen::Vector3d(std::cos(elevation) * std::cos(bearing),
+                                                        std::cos(elevation) * std::sin(bearing), std::sin(elevation));
+    bearing = std::atan2(dir.y(), dir.x());
+    elevation = std::asin(std::clamp(dir.z(), -1.0, 1.0));
+  }
   ray.bearing_rad = static_cast<float>(bearing);
   ray.elevation_rad = static_cast<float>(elevation);
   ray.dir_x = static_cast<float>(std::cos(elevation) * std::cos(bearing));
@@ -74,6 +84,13 @@ PixelRay OmniCameraModel::computeRay(double u, double v) const {
 }
 
 bool OmniCameraModel::projectDirection(double bearing_rad, double elevation_rad, double* u, double* v) const {
+  if (tilted_) {  // into the camera's frame
+    const Eigen::Vector3d dir =
+        tilt_.transpose() * Eigen::Vector3d(std::cos(elevation_rad) * std::cos(bearing_rad),
+                                            std::cos(elevation_rad) * std::sin(bearing_rad), std::sin(elevation_rad));
+    bearing_rad = std::atan2(dir.y(), dir.x());
+    elevation_rad = std::asin(std::clamp(dir.z(), -1.0, 1.0));
+  }
   const double r = radiusAtElevation(elevation_rad);
   if (!std::isfinite(r) || r < camera_.chassis_radius_px || r > camera_.mirror_radius_px) return false;
   // bearing = sign * phi + offset, sign = +-1.

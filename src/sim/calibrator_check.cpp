@@ -68,15 +68,19 @@ bool CalibratorCheck::passed() const {
          sign_right;
 }
 
-CalibratorCheck checkCalibrator(uint32_t seed) {
-  const FamilyScene scene = makeFamilyScene(seed, ScenarioLength::kSmall, /*ball_looks=*/false);
+CalibratorCheck checkCalibrator(uint32_t seed, double tilt_x_rad, double tilt_y_rad) {
+  FamilyScene scene = makeFamilyScene(seed, ScenarioLength::kSmall, /*ball_looks=*/false);
+  scene.calibration.camera.tilt_x_rad = tilt_x_rad;
+  scene.calibration.camera.tilt_y_rad = tilt_y_rad;
   CalibratorCheck check;
   check.seed = seed;
   check.summary = scene.summary;
   const core::Pose2D truth = scene.scenario.frames.front().scene.robot_pose;
   core::MirrorCalibratorOptions options;
   options.pose = {truth.x_m + 0.3, truth.y_m - 0.2, wrap(truth.theta_rad + 12 * kPi / 180)};
-  options.height_m = 0.7;
+  // Upright, ground distances depend on the height and the elevations only jointly; tilted, the
+  // tilt's effect on them depends on the height, which a team measures: then it is told.
+  options.height_m = tilt_x_rad != 0 || tilt_y_rad != 0 ? scene.calibration.camera.height_m : 0.7;
   // Used only when the image cannot tell the sign (a pose near the field's long axis).
   options.bearing_sign_prior = scene.calibration.camera.bearing_sign;
   const core::MirrorCalibrator calibrator(scene.calibration.field, options);
@@ -109,6 +113,8 @@ CalibratorCheck checkCalibrator(uint32_t seed) {
       compareMappings(scene.calibration, truth, fit.calibration.camera, fit.pose, r_min, percentile(radii, 0.98));
   check.whole = compareMappings(scene.calibration, truth, fit.calibration.camera, fit.pose);
   check.sign_right = fit.calibration.camera.bearing_sign == true_camera.bearing_sign;
+  check.tilt_x_rad = fit.calibration.camera.tilt_x_rad;
+  check.tilt_y_rad = fit.calibration.camera.tilt_y_rad;
   return check;
 }
 
@@ -124,13 +130,18 @@ std::string formatCalibratorChecks(const std::vector<CalibratorCheck>& checks) {
     passed += c.passed();
     refused += refuses;
     written_wrong += !refuses && !c.passed();
+    std::string profile = c.profile;
+    if (c.tilt_x_rad != 0 || c.tilt_y_rad != 0) {
+      std::snprintf(line, sizeof(line), ", tilted %.2f deg", std::hypot(c.tilt_x_rad, c.tilt_y_rad) * 180 / kPi);
+      profile += line;
+    }
     if (!c.fitted) {
       out << "| " << c.seed << " | refused: " << c.refusal << " | | | | | | | | ";
     } else {
       std::snprintf(
           line, sizeof(line),
           "| %u | %s | %s | %.2f%% / %.2f%% | %.2f%% / %.2f%% | %.2f | %.3f m | %.3f m, %.2f, %.1f%% | %.1f s | ",
-          c.seed, c.passed() ? "within the targets" : (refuses ? "refused" : "written, off target"), c.profile.c_str(),
+          c.seed, c.passed() ? "within the targets" : (refuses ? "refused" : "written, off target"), profile.c_str(),
           100 * c.lines.distance_median, 100 * c.lines.distance_p95, 100 * c.whole.distance_median,
           100 * c.whole.distance_p95, std::max(c.lines.bearing_p95_deg, c.whole.bearing_p95_deg), c.pose_error_m,
           c.residual_median_m, c.carpet_inlier_fraction, 100 * c.carpet_on_lines, c.seconds);

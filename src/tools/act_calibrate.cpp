@@ -219,9 +219,11 @@ int main(int argc, char** argv) {
           "/px; "
           "monotone %.4f m)\n",
           fit.profile.c_str(), fit.tan_rms_m, fit.tan_a_m, fit.tan_b_per_px, fit.monotone_rms_m);
-      std::printf("camera: centre (%.1f, %.1f), bearing sign %d, offset %.4f rad, chassis %.0f px, mirror %.0f px\n",
-                  c.center_u, c.center_v, c.bearing_sign, c.bearing_offset_rad, c.chassis_radius_px,
-                  c.mirror_radius_px);
+      std::printf(
+          "camera: centre (%.1f, %.1f), bearing sign %d, offset %.4f rad, chassis %.0f px, mirror %.0f px, tilt [%.4f, "
+          "%.4f] rad (coverage of the model's lines upright %.3f, tilted %.3f)\n",
+          c.center_u, c.center_v, c.bearing_sign, c.bearing_offset_rad, c.chassis_radius_px, c.mirror_radius_px,
+          c.tilt_x_rad, c.tilt_y_rad, fit.upright_coverage, fit.tilted_coverage);
       std::printf("pose: %.3f, %.3f, %.4f\n", pose.x_m, pose.y_m, pose.theta_rad);
       for (const std::string& note : fit.notes) std::printf("note: %s\n", note.c_str());
       printResidual("residual", fit.residual);

@@ -187,6 +187,27 @@ TEST(Calibration, LabFieldKeysAreChecked) {
             std::string::npos);
 }
 
+// Issue 12: a mirror axis off the vertical is the optional key camera.tilt (x, y, rad); a file
+// without it is untilted and writes no such key.
+TEST(Calibration, TiltIsOptionalCheckedAndRoundTrips) {
+  const std::string text = contractText();
+  auto tilted = [&](const std::string& value) {
+    return replaced(text, "  height_m: 0.75", "  height_m: 0.75\n  tilt: " + value);
+  };
+  const auto c = parseCalibration(tilted("[0.02, -0.01]"), "cal.yaml");
+  EXPECT_DOUBLE_EQ(c.camera.tilt_x_rad, 0.02);
+  EXPECT_DOUBLE_EQ(c.camera.tilt_y_rad, -0.01);
+  const auto d = parseCalibration(act_color::core::toYaml(c), "roundtrip");
+  EXPECT_EQ(act_color::core::toYaml(c), act_color::core::toYaml(d));
+  EXPECT_DOUBLE_EQ(d.camera.tilt_y_rad, -0.01);
+  const auto plain = act_color::test::contractCalibration();
+  EXPECT_EQ(plain.camera.tilt_x_rad, 0.0);
+  EXPECT_EQ(act_color::core::toYaml(plain).find("tilt"), std::string::npos);
+  EXPECT_NE(errorOf(tilted("[0.3, 0.3]")).find("camera.tilt: must be finite and at most"), std::string::npos);
+  EXPECT_NE(errorOf(tilted("[0.01]")).find("camera.tilt"), std::string::npos);
+  EXPECT_NE(errorOf(tilted("0.01")).find("camera.tilt"), std::string::npos);
+}
+
 // Issue 15: hostile calibration files are refused with a message, in bounded time and memory.
 TEST(Calibration, NestingSizeAndSyntaxAreBoundedAndLocated) {
   // 40,000 levels of nesting (80 KB): refused at the limit, no stack overflow.

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <tuple>
 
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/mirror_calibrator.hpp"
@@ -50,6 +51,25 @@ TEST(MirrorCalibrator, FitsRandomSimulatedCameras) {
     EXPECT_LT(c.whole.unmapped, c.whole.pixels / 50) << seed;
     EXPECT_TRUE(c.sign_right) << seed;
     EXPECT_TRUE(c.passed()) << seed;
+    EXPECT_EQ(c.tilt_x_rad, 0.0) << seed;  // upright cameras: no tilt taken
+    EXPECT_EQ(c.tilt_y_rad, 0.0) << seed;
+  }
+}
+
+// A camera mounted 1.6-2 degrees askew (camera.tilt; NuBot's nubot_2 and nubot_101 are, by their
+// fit), told its height: the calibrator finds the tilt and the mapping is within the targets. An
+// upright fit of the same images was off by a bearing of 4-10 degrees and a p95 distance of 5-11%
+// (seeds 8, 22, 30). Not every tilted camera is fitted this well yet: seeds 0 and 1003, tilted
+// likewise, came within 0.9 and 0.5 degrees but 15% and 2.6% (p95), and 4 was refused.
+TEST(MirrorCalibrator, FindsATiltedMirrorAxis) {
+  for (const auto& [seed, tx, ty] :
+       {std::tuple<uint32_t, double, double>{8u, 0.03, 0.0}, {22u, 0.02, -0.02}, {30u, 0.0, -0.035}}) {
+    const sim::CalibratorCheck c = sim::checkCalibrator(seed, tx, ty);
+    std::printf("%s", sim::formatCalibratorChecks({c}).c_str());
+    ASSERT_TRUE(c.fitted) << c.refusal;
+    EXPECT_TRUE(c.passed()) << seed;
+    EXPECT_NEAR(c.tilt_x_rad, tx, 0.01) << seed;
+    EXPECT_NEAR(c.tilt_y_rad, ty, 0.01) << seed;
   }
 }
 

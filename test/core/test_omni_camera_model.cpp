@@ -58,7 +58,10 @@ TEST(OmniCameraModel, ProjectionInvertsTheRays) {
     auto c = cal;
     c.bearing_sign = -1;
     c.bearing_offset_rad = 0.3;
-    for (const auto& cam_cal : {cal, c}) {
+    auto t = c;
+    t.tilt_x_rad = 0.03;
+    t.tilt_y_rad = -0.02;
+    for (const auto& cam_cal : {cal, c, t}) {
       const OmniCameraModel camera(cam_cal);
       for (double x : {-4.0, -1.0, 0.5, 2.0, 6.0}) {
         for (double y : {-3.0, 0.2, 1.0, 5.0}) {
@@ -72,4 +75,24 @@ TEST(OmniCameraModel, ProjectionInvertsTheRays) {
       }
     }
   }
+}
+
+// camera.tilt: the view rays turn by the rotation vector (x, y) in base_link. A tilt about +y of
+// 0.05 rad turns the rays that look along +x down by 0.05 (the floor they meet comes nearer) and
+// those along -x up by as much; rays along y keep their elevation to first order.
+TEST(OmniCameraModel, TiltTurnsTheViewRays) {
+  auto cal = act_color::test::contractCalibration().camera;
+  cal.tilt_y_rad = 0.05;
+  const OmniCameraModel camera(cal);
+  const PixelRay& ahead = camera.ray(290 + 164, 290);  // elevation -0.625 untilted, bearing 0
+  ASSERT_EQ(ahead.region, PixelRegion::kFloor);
+  EXPECT_NEAR(ahead.elevation_rad, -0.675, 1e-6);
+  EXPECT_NEAR(ahead.bearing_rad, 0.0, 1e-6);
+  EXPECT_NEAR(ahead.ground_x_m, 0.75 / std::tan(0.675), 1e-5);
+  const PixelRay& behind = camera.ray(290 - 164, 290);
+  EXPECT_NEAR(behind.elevation_rad, -0.575, 1e-6);
+  EXPECT_NEAR(behind.ground_x_m, -0.75 / std::tan(0.575), 1e-5);
+  const PixelRay& side = camera.ray(290, 290 + 164);
+  EXPECT_NEAR(side.elevation_rad, -0.625, 2e-3);
+  EXPECT_NEAR(std::hypot(std::hypot(side.dir_x, side.dir_y), side.dir_z), 1.0, 1e-6);
 }

@@ -15,6 +15,9 @@ namespace core {
 // built for every pixel): 8192 px a side, 16 Mpx in all.
 constexpr int kMaxImageSidePx = 8192;
 constexpr int64_t kMaxImagePixels = int64_t{4096} * 4096;
+// Largest tilt of the mirror axis a calibration may state (camera.tilt): 0.35 rad, 20 degrees; a
+// mount askew by more is not a tilt to correct.
+constexpr double kMaxTiltRad = 0.35;
 
 struct CameraCalibration {
   int width = 0;
@@ -28,6 +31,11 @@ struct CameraCalibration {
   double mirror_radius_px = 0.0;
   // (r_px, elevation_rad), both strictly increasing.
   std::vector<std::pair<double, double>> elevation_map;
+  // Optional (camera.tilt): the mirror axis' tilt from the vertical, a rotation vector (about
+  // base_link's x and y axes, rad) applied to every view ray the elevation map gives; a camera or
+  // mirror mounted a degree or two askew sees one side of the field nearer than the other.
+  double tilt_x_rad = 0.0;
+  double tilt_y_rad = 0.0;
   // Optional: pixels that show the own robot wherever it stands (mirror struts, a cable), row-major,
   // 1 = own robot; empty = none. Read from the PNG `self_mask_file` names (key camera.self_mask,
   // relative to the calibration file); nonzero pixels of the PNG are the mask.

@@ -81,8 +81,11 @@ struct MirrorFit {
   // RMS distance to the lines' middles over the line pixels both profiles take for inliers: the
   // profile with the smaller one is chosen (the monotone one only when 5% smaller).
   double tan_rms_m = 0.0, monotone_rms_m = 0.0;
-  LineResidual residual;                 // of the chosen profile
-  double carpet_on_lines = 0.0;          // fraction of carpet pixels that land on a painted model line
+  LineResidual residual;         // of the chosen profile
+  double carpet_on_lines = 0.0;  // fraction of carpet pixels that land on a painted model line
+  // How much of the model's lines line pixels cover, upright and with the tilt free (camera.tilt:
+  // taken when clearly more; both 0 when the upright fit would be refused and no tilt was tried).
+  double upright_coverage = 0.0, tilted_coverage = 0.0;
   std::vector<cv::Point2f> line_pixels;  // candidates found in the image
   ImageGeometry image_geometry;
   std::vector<std::string> notes;  // what was assumed (sign prior, goal colors, ...)

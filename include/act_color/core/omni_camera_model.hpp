@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <vector>
 
 #include "act_color/core/calibration.hpp"
@@ -59,6 +60,8 @@ class OmniCameraModel {
 
  private:
   CameraCalibration camera_;
+  bool tilted_ = false;
+  Eigen::Matrix3d tilt_ = Eigen::Matrix3d::Identity();  // camera.tilt: camera frame -> base_link
   std::vector<PixelRay> rays_;
 };
 

@@ -43,12 +43,16 @@ struct CalibratorCheck {
   MappingError lines;
   MappingError whole;  // the whole field
   bool sign_right = false;
-  double seconds = 0;  // the fit's run time
+  double tilt_x_rad = 0, tilt_y_rad = 0;  // the fit's camera.tilt
+  double seconds = 0;                     // the fit's run time
   // Within the targets: p95 of `lines` < 2%, median of `whole` < 2%, bearing p95 < 1 degree on
   // both, the sign right, under 2% of the field unmapped, and not refused.
   bool passed() const;
 };
-CalibratorCheck checkCalibrator(uint32_t seed);
+// `tilt_x_rad`, `tilt_y_rad`: the scene's camera tilted so (camera.tilt; the family's are upright);
+// a tilted camera's calibrator is told the true height (a tilt moves ground points by an amount
+// that depends on it).
+CalibratorCheck checkCalibrator(uint32_t seed, double tilt_x_rad = 0.0, double tilt_y_rad = 0.0);
 std::string formatCalibratorChecks(const std::vector<CalibratorCheck>& checks);
 
 }  // namespace sim
