@@ -46,8 +46,8 @@ struct MirrorCalibratorOptions {
   double inlier_distance_m = 0.08;  // a line pixel this close to a model line is an inlier
   std::string profile = "auto";     // "tan", "monotone" or "auto": the one with the smaller residual
   // Fraction of carpet pixels the fit may put on painted lines: right fits put 0-0.5% there on
-  // simulated cameras and 0-0.1% on NuBot's images (1.7% on nubot_2, whose field may not be the
-  // preset's); two half-turn fits of random cameras 2.2% and 2.4% (bearing 173 and 180 degrees off),
+  // simulated cameras and 0-0.1% on NuBot's images (nubot_2 1.7% fitted upright, 0.1% with its
+  // tilt, camera.tilt); two half-turn fits of random cameras 2.2% and 2.4% (bearing 173 and 180 degrees off),
   // written under the former 3%.
   double max_carpet_on_lines = 0.02;
 };
