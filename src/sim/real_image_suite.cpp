@@ -361,15 +361,21 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
       out << r.name << ": not fitted (" << r.why << ")\n\n";
       continue;
     }
-    std::snprintf(
-        line, sizeof(line),
-        "%s: %s, residual %.3f m, pose (%.2f, %.2f, %.1f deg), %zu hand-picked white pixels, "
-        "self mask %.1f%% of the image\n\n",
-        r.name.c_str(), r.fit.profile == "given" ? "the calibration given" : (r.fit.profile + " profile").c_str(),
-        r.fit.residual.median_m, r.fit.pose.x_m, r.fit.pose.y_m, r.fit.pose.theta_rad * 180.0 / M_PI, r.whites,
-        r.self_mask.empty() ? 0.0
-                            : 100.0 * std::count(r.self_mask.begin(), r.self_mask.end(), uint8_t{1}) /
-                                  static_cast<double>(r.self_mask.size()));
+    const core::CameraCalibration& camera = r.fit.calibration.camera;
+    std::string fitted = r.fit.profile == "given" ? "the calibration given" : r.fit.profile + " profile";
+    if (camera.tilt_x_rad != 0 || camera.tilt_y_rad != 0) {
+      std::snprintf(line, sizeof(line), " tilted %.1f deg",
+                    std::hypot(camera.tilt_x_rad, camera.tilt_y_rad) * 180 / M_PI);
+      fitted += line;
+    }
+    std::snprintf(line, sizeof(line),
+                  "%s: %s, residual %.3f m, pose (%.2f, %.2f, %.1f deg), %zu hand-picked white pixels, "
+                  "self mask %.1f%% of the image\n\n",
+                  r.name.c_str(), fitted.c_str(), r.fit.residual.median_m, r.fit.pose.x_m, r.fit.pose.y_m,
+                  r.fit.pose.theta_rad * 180.0 / M_PI, r.whites,
+                  r.self_mask.empty() ? 0.0
+                                      : 100.0 * std::count(r.self_mask.begin(), r.self_mask.end(), uint8_t{1}) /
+                                            static_cast<double>(r.self_mask.size()));
     out << line;
     if (r.nubot_green_agreement >= 0) {
       std::snprintf(line, sizeof(line),
