@@ -280,7 +280,7 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
   if (!(c.chassis_radius_px < c.mirror_radius_px)) {
     fail(source, "camera.chassis_radius_px", "must be smaller than camera.mirror_radius_px");
   }
-  if (!(std::hypot(c.tilt_x_rad, c.tilt_y_rad) <= kMaxTiltRad)) {
+  if (!(c.tiltRad() <= kMaxTiltRad)) {
     fail(source, "camera.tilt", "must be finite and at most " + std::to_string(kMaxTiltRad) + " rad from the vertical");
   }
   if (c.elevation_map.size() < 2) fail(source, "camera.elevation_map", "needs at least two entries");

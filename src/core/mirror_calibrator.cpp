@@ -222,10 +222,7 @@ struct Model {
   int size() const { return profileEnd() + (tilted ? 2 : 0); }
   // The tilt as a rotation of view directions in the field's frame (identity when not tilted).
   Eigen::Matrix3d tilt(const Eigen::VectorXd& p) const {
-    if (!tilted) return Eigen::Matrix3d::Identity();
-    const Eigen::Vector3d w(p[profileEnd()], p[profileEnd() + 1], 0.0);
-    if (!(w.norm() > 0)) return Eigen::Matrix3d::Identity();
-    return Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    return tilted ? tiltRotation(p[profileEnd()], p[profileEnd() + 1]) : Eigen::Matrix3d::Identity();
   }
 
   // Elevations at the knots (monotone).
@@ -1240,7 +1237,8 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
   // as many line pixels on the carpet for inliers and puts no more carpet on the lines. Only a
   // fit that stands upright: a tilt is no rescue for a wrong basin.
   if (rejection(result).empty()) {
-    Candidate tilted = use_mono ? mono : tan;
+    const Candidate& upright = use_mono ? mono : tan;
+    Candidate tilted = upright;
     tilted.model.tilted = true;
     Eigen::VectorXd q = Eigen::VectorXd::Zero(tilted.model.size());
     q.head(tilted.p.size()) = tilted.p;
@@ -1251,7 +1249,6 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
     Pose2D tilted_pose;
     const LineResidual tilted_res = finish(tilted, &tilted_cal, &tilted_pose);
     const double tilted_carpet = carpetOnLines(tilted_cal, tilted_pose);
-    const Candidate& upright = use_mono ? mono : tan;
     result.upright_coverage = full_fit.coverage(upright.model, upright.p, kTiltCoverageTauPx);
     result.tilted_coverage = full_fit.coverage(tilted.model, tilted.p, kTiltCoverageTauPx);
     if (result.tilted_coverage >= result.upright_coverage + kTiltCoverageGain &&
@@ -1261,8 +1258,7 @@ MirrorFit MirrorCalibrator::fitUnchecked(const cv::Mat& bgr) const {
       result.pose = tilted_pose;
       result.residual = tilted_res;
       result.carpet_on_lines = tilted_carpet;
-      const double degrees = std::hypot(tilted_cal.camera.tilt_x_rad, tilted_cal.camera.tilt_y_rad) * 180.0 / kPi;
-      result.notes.push_back("the mirror axis is tilted " + fixed(degrees, 1) +
+      result.notes.push_back("the mirror axis is tilted " + fixed(tilted_cal.camera.tiltRad() * 180.0 / kPi, 1) +
                              " degrees from the vertical (camera.tilt)");
     }
   }

@@ -7,10 +7,14 @@
 namespace act_color {
 namespace core {
 
-OmniCameraModel::OmniCameraModel(const CameraCalibration& camera) : camera_(camera) {
-  const Eigen::Vector3d tilt(camera_.tilt_x_rad, camera_.tilt_y_rad, 0.0);
-  tilted_ = tilt.norm() > 0;
-  if (tilted_) tilt_ = Eigen::AngleAxisd(tilt.norm(), tilt.normalized()).toRotationMatrix();
+Eigen::Matrix3d tiltRotation(double tilt_x_rad, double tilt_y_rad) {
+  const Eigen::Vector3d w(tilt_x_rad, tilt_y_rad, 0.0);
+  if (!(w.norm() > 0)) return Eigen::Matrix3d::Identity();
+  return Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+}
+
+OmniCameraModel::OmniCameraModel(const CameraCalibration& camera)
+    : camera_(camera), tilted_(camera.tiltRad() > 0), tilt_(tiltRotation(camera.tilt_x_rad, camera.tilt_y_rad)) {
   rays_.resize(static_cast<size_t>(camera_.width) * camera_.height);
   for (int v = 0; v < camera_.height; ++v) {
     for (int u = 0; u < camera_.width; ++u) rays_[static_cast<size_t>(v) * camera_.width + u] = computeRay(u, v);

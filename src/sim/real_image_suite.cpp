@@ -363,9 +363,8 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
     }
     const core::CameraCalibration& camera = r.fit.calibration.camera;
     std::string fitted = r.fit.profile == "given" ? "the calibration given" : r.fit.profile + " profile";
-    if (camera.tilt_x_rad != 0 || camera.tilt_y_rad != 0) {
-      std::snprintf(line, sizeof(line), " tilted %.1f deg",
-                    std::hypot(camera.tilt_x_rad, camera.tilt_y_rad) * 180 / M_PI);
+    if (camera.tiltRad() > 0) {
+      std::snprintf(line, sizeof(line), " tilted %.1f deg", camera.tiltRad() * 180 / M_PI);
       fitted += line;
     }
     std::snprintf(line, sizeof(line),

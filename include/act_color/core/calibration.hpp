@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -36,6 +37,7 @@ struct CameraCalibration {
   // mirror mounted a degree or two askew sees one side of the field nearer than the other.
   double tilt_x_rad = 0.0;
   double tilt_y_rad = 0.0;
+  double tiltRad() const { return std::hypot(tilt_x_rad, tilt_y_rad); }  // from the vertical
   // Optional: pixels that show the own robot wherever it stands (mirror struts, a cable), row-major,
   // 1 = own robot; empty = none. Read from the PNG `self_mask_file` names (key camera.self_mask,
   // relative to the calibration file); nonzero pixels of the PNG are the mask.

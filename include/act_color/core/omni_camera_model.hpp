@@ -32,6 +32,10 @@ struct PixelRay {
   float dir_z = 0.f;
 };
 
+// camera.tilt's rotation of view directions (camera frame -> base_link) for a rotation vector
+// (tilt_x_rad, tilt_y_rad, 0); the identity for none.
+Eigen::Matrix3d tiltRotation(double tilt_x_rad, double tilt_y_rad);
+
 // The contract's camera model: pixel -> bearing/elevation -> floor point, precomputed for every
 // pixel of the calibrated image size.
 class OmniCameraModel {
@@ -60,8 +64,8 @@ class OmniCameraModel {
 
  private:
   CameraCalibration camera_;
-  bool tilted_ = false;
-  Eigen::Matrix3d tilt_ = Eigen::Matrix3d::Identity();  // camera.tilt: camera frame -> base_link
+  bool tilted_;           // camera.tilt is not zero
+  Eigen::Matrix3d tilt_;  // camera.tilt: camera frame -> base_link
   std::vector<PixelRay> rays_;
 };
 
