@@ -789,6 +789,7 @@ ImageGeometry MirrorCalibrator::estimateImageGeometry(const cv::Mat& bgr) const 
   cv::morphologyEx(not_floor, not_floor, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
   cv::Mat labels, stats, centroids;
   const int n = cv::connectedComponentsWithStats(not_floor, labels, stats, centroids, 8);
+  const cv::Mat goal_colored = masks.yellow | masks.blue;
   const Eigen::Vector2d image_center(0.5 * bgr.cols, 0.5 * bgr.rows);
   double best_score = -1;
   for (int i = 1; i < n; ++i) {
@@ -796,6 +797,10 @@ ImageGeometry MirrorCalibrator::estimateImageGeometry(const cv::Mat& bgr) const 
     const int w = stats.at<int>(i, cv::CC_STAT_WIDTH), h = stats.at<int>(i, cv::CC_STAT_HEIGHT);
     if (left == 0 || top == 0 || left + w >= bgr.cols || top + h >= bgr.rows) continue;  // the outside
     const double area = stats.at<int>(i, cv::CC_STAT_AREA);
+    // A goal is a large compact region too, but of a goal's color (seed 44 of the family: the
+    // yellow goal was taken for the chassis).
+    const cv::Rect box(left, top, w, h);
+    if (cv::countNonZero((labels(box) == i) & goal_colored(box)) > 0.5 * area) continue;
     const Eigen::Vector2d c(centroids.at<double>(i, 0), centroids.at<double>(i, 1));
     // Compact, large and near the image centre.
     const double compact = area / std::max(1.0, static_cast<double>(w) * h);
