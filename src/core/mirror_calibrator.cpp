@@ -295,8 +295,7 @@ class LineFit {
       }
       const double b = p[2] + model.sign * std::atan2(dv, du);
       if (model.tilted) {
-        const Eigen::Vector3d dir =
-            tilt * Eigen::Vector3d(std::cos(e) * std::cos(b), std::cos(e) * std::sin(b), std::sin(e));
+        const Eigen::Vector3d dir = tilt * viewDirection(b, e);
         if (!(dir.z() < 0)) {
           (*out)[i] = kOff;
           continue;

@@ -13,6 +13,22 @@ Eigen::Matrix3d tiltRotation(double tilt_x_rad, double tilt_y_rad) {
   return Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
 }
 
+Eigen::Vector3d viewDirection(double bearing_rad, double elevation_rad) {
+  return {std::cos(elevation_rad) * std::cos(bearing_rad), std::cos(elevation_rad) * std::sin(bearing_rad),
+          std::sin(elevation_rad)};
+}
+
+namespace {
+
+// A view direction's bearing and elevation after the rotation `turn`.
+void turnView(const Eigen::Matrix3d& turn, double* bearing_rad, double* elevation_rad) {
+  const Eigen::Vector3d dir = turn * viewDirection(*bearing_rad, *elevation_rad);
+  *bearing_rad = std::atan2(dir.y(), dir.x());
+  *elevation_rad = std::asin(std::clamp(dir.z(), -1.0, 1.0));
+}
+
+}  // namespace
+
 OmniCameraModel::OmniCameraModel(const CameraCalibration& camera)
     : camera_(camera), tilted_(camera.tiltRad() > 0), tilt_(tiltRotation(camera.tilt_x_rad, camera.tilt_y_rad)) {
   rays_.resize(static_cast<size_t>(camera_.width) * camera_.height);
@@ -65,12 +81,7 @@ PixelRay OmniCameraModel::computeRay(double u, double v) const {
   }
   double elevation = elevationAtRadius(r);
   double bearing = camera_.bearing_sign * std::atan2(dv, du) + camera_.bearing_offset_rad;
-  if (tilted_) {
-    const Eigen::Vector3d dir = tilt_ * Eigen::Vector3d(std::cos(elevation) * std::cos(bearing),
-                                                        std::cos(elevation) * std::sin(bearing), std::sin(elevation));
-    bearing = std::atan2(dir.y(), dir.x());
-    elevation = std::asin(std::clamp(dir.z(), -1.0, 1.0));
-  }
+  if (tilted_) turnView(tilt_, &bearing, &elevation);
   ray.bearing_rad = static_cast<float>(bearing);
   ray.elevation_rad = static_cast<float>(elevation);
   ray.dir_x = static_cast<float>(std::cos(elevation) * std::cos(bearing));
@@ -88,13 +99,7 @@ PixelRay OmniCameraModel::computeRay(double u, double v) const {
 }
 
 bool OmniCameraModel::projectDirection(double bearing_rad, double elevation_rad, double* u, double* v) const {
-  if (tilted_) {  // into the camera's frame
-    const Eigen::Vector3d dir =
-        tilt_.transpose() * Eigen::Vector3d(std::cos(elevation_rad) * std::cos(bearing_rad),
-                                            std::cos(elevation_rad) * std::sin(bearing_rad), std::sin(elevation_rad));
-    bearing_rad = std::atan2(dir.y(), dir.x());
-    elevation_rad = std::asin(std::clamp(dir.z(), -1.0, 1.0));
-  }
+  if (tilted_) turnView(tilt_.transpose(), &bearing_rad, &elevation_rad);  // into the camera's frame
   const double r = radiusAtElevation(elevation_rad);
   if (!std::isfinite(r) || r < camera_.chassis_radius_px || r > camera_.mirror_radius_px) return false;
   // bearing = sign * phi + offset, sign = +-1.

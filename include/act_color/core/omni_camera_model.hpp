@@ -35,6 +35,9 @@ struct PixelRay {
 // camera.tilt's rotation of view directions (camera frame -> base_link) for a rotation vector
 // (tilt_x_rad, tilt_y_rad, 0); the identity for none.
 Eigen::Matrix3d tiltRotation(double tilt_x_rad, double tilt_y_rad);
+// The unit view direction of a bearing (counter-clockwise from x) and an elevation (up from the
+// horizon).
+Eigen::Vector3d viewDirection(double bearing_rad, double elevation_rad);
 
 // The contract's camera model: pixel -> bearing/elevation -> floor point, precomputed for every
 // pixel of the calibrated image size.
