@@ -50,9 +50,9 @@ struct ActParams {
   // (instead of add_stride), so that what the moved table misses is filled at once (ActTrainer's
   // kDenseAddCycles).
   int light_change_add_stride = 50;
-  // A cell confirmed by an in-field sample of its class (within zeta * sigma) in the last n
-  // cycles is not removed for being seen off the field: colors seen on both sides (a dark
-  // poster like a robot) stay with the class that needs them. 0: the paper's removal.
+  // A black cell confirmed by an in-field sample (within zeta * sigma) in the last n cycles is not
+  // removed for being seen off the field: the robots' colors, which dark hall clutter shows too,
+  // stay with black while robots confirm them. 0: the paper's removal.
   int removal_protect_cycles = 10;
   // The other robots' height (m; MSL: at most 0.8). A robot standing on the carpet is imaged
   // farther out than where it stands (its top at h / (h - H) times the floor range, h the camera's
