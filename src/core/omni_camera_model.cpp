@@ -84,9 +84,10 @@ PixelRay OmniCameraModel::computeRay(double u, double v) const {
   if (tilted_) turnView(tilt_, &bearing, &elevation);
   ray.bearing_rad = static_cast<float>(bearing);
   ray.elevation_rad = static_cast<float>(elevation);
-  ray.dir_x = static_cast<float>(std::cos(elevation) * std::cos(bearing));
-  ray.dir_y = static_cast<float>(std::cos(elevation) * std::sin(bearing));
-  ray.dir_z = static_cast<float>(std::sin(elevation));
+  const Eigen::Vector3d dir = viewDirection(bearing, elevation);
+  ray.dir_x = static_cast<float>(dir.x());
+  ray.dir_y = static_cast<float>(dir.y());
+  ray.dir_z = static_cast<float>(dir.z());
   if (elevation < 0) {
     ray.region = PixelRegion::kFloor;
     const double ground = camera_.height_m / std::tan(-elevation);
