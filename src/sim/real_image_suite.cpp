@@ -1,9 +1,11 @@
 #include "act_color/sim/real_image_suite.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
@@ -33,8 +35,10 @@ constexpr double kNoiseDn = 2.0;
 constexpr int kMarginPx = 3;
 // Frames the "before" and "after" figures are averaged over.
 constexpr int kAveragedFrames = 10;
-// Issue 11's real-image targets for the "any fixed table" row.
-constexpr double kTargetWhiteRecall = 0.50, kTargetGreenRecall = 0.88;
+// The real-image targets (issue 12's "Checked by", first set in issue 6): the "any fixed table" rows
+// and formatRealImageTargets.
+constexpr double kTargetWhiteRecall = 0.50, kTargetGreenRecall = 0.88, kTargetHallInField = 0.15;
+constexpr int kTargetWhiteBackCycles = 12;
 
 // Pixels expected `k` whose (2 kMarginPx + 1)^2 neighbourhood is all expected `k`.
 std::vector<int> interiorPixels(const cv::Mat& expected, uint8_t k, int step) {
@@ -467,6 +471,100 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
       }
       out << "\n";
     }
+  }
+  return out.str();
+}
+
+std::string formatRealImageTargets(const std::vector<RealImageResult>& results) {
+  // Per image and mode: the changes of light that meet white, green, hall, white back, all four.
+  struct Tally {
+    std::array<int, 5> met{};
+    int changes = 0, with_white = 0;
+  };
+  std::vector<std::string> modes;
+  std::map<std::string, Tally> totals;
+  std::map<std::string, std::vector<std::string>> misses;
+  std::ostringstream table;
+  char line[256];
+  auto cell = [](int met, int of) {
+    return of == 0 ? std::string("-") : std::to_string(met) + "/" + std::to_string(of);
+  };
+  auto row = [&](const std::string& image, const std::string& mode, const Tally& t) {
+    table << "| " << image << " | " << mode << " | " << cell(t.met[0], t.with_white) << " | "
+          << cell(t.met[1], t.changes) << " | " << cell(t.met[2], t.changes) << " | " << cell(t.met[3], t.with_white)
+          << " | " << cell(t.met[4], t.changes) << " |\n";
+  };
+  for (const RealImageResult& r : results) {
+    if (!r.fitted) continue;
+    std::map<std::string, Tally> tallies;
+    std::vector<std::string> image_modes;
+    for (const RealVariantResult& v : r.rows) {
+      if (v.variant == "wrong_pose") continue;
+      if (std::find(image_modes.begin(), image_modes.end(), v.mode) == image_modes.end()) image_modes.push_back(v.mode);
+      if (std::find(modes.begin(), modes.end(), v.mode) == modes.end()) modes.push_back(v.mode);
+      Tally& t = tallies[v.mode];
+      const bool white = v.before.white_recall >= 0;
+      const std::array<bool, 4> ok = {
+          !white || std::min(v.before.white_recall, v.after.white_recall) >= kTargetWhiteRecall,
+          std::min(v.before.green_recall, v.after.green_recall) >= kTargetGreenRecall,
+          std::max(v.before.hall_in_field, v.after.hall_in_field) <= kTargetHallInField,
+          !white || (v.white_recovery_cycles >= 0 && v.white_recovery_cycles <= kTargetWhiteBackCycles)};
+      ++t.changes;
+      t.with_white += white;
+      for (size_t k = 0; k < ok.size(); ++k) t.met[k] += (k == 0 || k == 3) ? white && ok[k] : ok[k];
+      const bool all = ok[0] && ok[1] && ok[2] && ok[3];
+      t.met[4] += all;
+      if (all) continue;
+      std::string why;
+      auto add = [&](const char* text) { why += (why.empty() ? "" : ", ") + std::string(text); };
+      if (!ok[0]) {
+        std::snprintf(line, sizeof(line), "white %.2f / %.2f", v.before.white_recall, v.after.white_recall);
+        add(line);
+      }
+      if (!ok[1]) {
+        std::snprintf(line, sizeof(line), "green %.2f / %.2f", v.before.green_recall, v.after.green_recall);
+        add(line);
+      }
+      if (!ok[2]) {
+        std::snprintf(line, sizeof(line), "hall %.2f / %.2f", v.before.hall_in_field, v.after.hall_in_field);
+        add(line);
+      }
+      if (!ok[3]) {
+        std::snprintf(line, sizeof(line), v.white_recovery_cycles < 0 ? "white never back" : "white back in %d",
+                      v.white_recovery_cycles);
+        add(line);
+      }
+      misses[v.mode].push_back(r.name + ", " + v.variant + ": " + why);
+    }
+    for (const std::string& mode : image_modes) {
+      const Tally& t = tallies[mode];
+      row(r.name, mode, t);
+      Tally& total = totals[mode];
+      total.changes += t.changes;
+      total.with_white += t.with_white;
+      for (size_t k = 0; k < t.met.size(); ++k) total.met[k] += t.met[k];
+    }
+  }
+  if (modes.empty()) return "";
+  std::ostringstream out;
+  std::snprintf(line, sizeof(line),
+                "Issue 12's targets on each change of light (not wrong_pose): white recall >= %.2f on the hand-picked "
+                "pixels, green >= %.2f, hall in a field class <= %.2f, before and after; white back within %d "
+                "cycles. Changes that meet them:\n\n",
+                kTargetWhiteRecall, kTargetGreenRecall, kTargetHallInField, kTargetWhiteBackCycles);
+  out << line << "| image | mode | white | green | hall | white back | all |\n|---|---|---|---|---|---|---|\n"
+      << table.str();
+  for (const std::string& mode : modes) {
+    table.str("");
+    row("all images", mode, totals[mode]);
+    out << table.str();
+  }
+  out << "\n";
+  for (const std::string& mode : modes) {
+    if (misses[mode].empty()) continue;
+    out << mode << ", the changes that miss (" << misses[mode].size() << "):\n";
+    for (const std::string& miss : misses[mode]) out << "- " << miss << "\n";
+    out << "\n";
   }
   return out.str();
 }

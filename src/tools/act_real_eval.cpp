@@ -187,7 +187,7 @@ int main(int argc, char** argv) {
     }
     std::cerr << "act_real_eval: " << image.name << " done\n";
   }
-  std::cout << act_color::sim::formatRealImageReport(results);
+  std::cout << act_color::sim::formatRealImageReport(results) << act_color::sim::formatRealImageTargets(results);
   if (frames) std::cout << act_color::sim::formatRealImageFrames(results);
   return 0;
 }

@@ -52,6 +52,58 @@ void expectHolds(const sim::RealImageResult& r) {
   }
 }
 
+// formatRealImageTargets on hand-made results: what counts as meeting issue 12's targets.
+sim::RealVariantResult change(const std::string& variant, const std::string& mode, double white_before,
+                              double white_after, double green_after, double hall_after, int back) {
+  sim::RealVariantResult v;
+  v.variant = variant;
+  v.mode = mode;
+  v.before.white_recall = white_before;
+  v.after.white_recall = white_after;
+  v.before.green_recall = 0.95;
+  v.after.green_recall = green_after;
+  v.before.hall_in_field = 0.05;
+  v.after.hall_in_field = hall_after;
+  v.white_recovery_cycles = back;
+  return v;
+}
+
+TEST(RealImageTargets, CountsEachTargetAndNamesTheMisses) {
+  sim::RealImageResult a;
+  a.name = "cam_a";
+  a.fitted = true;
+  a.rows = {change("gain_0.5", "defaults", 0.80, 0.78, 0.90, 0.10, 3),     // meets all
+            change("gain_0.5", "paper", 0.60, 0.40, 0.90, 0.10, -1),       // white after, never back
+            change("darken", "defaults", 0.80, 0.80, 0.87, 0.10, 12),      // green after; 12 cycles is in time
+            change("darken", "paper", 0.80, 0.80, 0.90, 0.16, 13),         // hall after, back too late
+            change("wrong_pose", "defaults", 0.10, 0.10, 0.10, 0.90, -1),  // not a change of light
+            change("wrong_pose", "paper", 0.10, 0.10, 0.10, 0.90, -1)};
+  sim::RealImageResult b;  // no hand-picked pixels: white and its recovery are not measured
+  b.name = "cam_b";
+  b.fitted = true;
+  b.rows = {change("brighten", "defaults", -1, -1, 0.95, 0.20, -1)};
+  sim::RealImageResult c;
+  c.name = "cam_c";
+  c.why = "no fit";
+  const std::string text = sim::formatRealImageTargets({a, b, c});
+  auto has = [&](const std::string& part) { EXPECT_NE(text.find(part), std::string::npos) << part << "\n" << text; };
+  // | image | mode | white | green | hall | white back | all |
+  has("| cam_a | defaults | 2/2 | 1/2 | 2/2 | 2/2 | 1/2 |");
+  has("| cam_a | paper | 1/2 | 2/2 | 1/2 | 0/2 | 0/2 |");
+  has("| cam_b | defaults | - | 1/1 | 0/1 | - | 0/1 |");
+  has("| all images | defaults | 2/2 | 2/3 | 2/3 | 2/2 | 1/3 |");
+  has("| all images | paper | 1/2 | 2/2 | 1/2 | 0/2 | 0/2 |");
+  has("defaults, the changes that miss (2):\n- cam_a, darken: green 0.95 / 0.87\n- cam_b, brighten: hall 0.05 / "
+      "0.20\n");
+  has("paper, the changes that miss (2):\n- cam_a, gain_0.5: white 0.60 / 0.40, white never back\n"
+      "- cam_a, darken: hall 0.05 / 0.16, white back in 13\n");
+  const size_t heading = text.find("(not wrong_pose)");  // named only where the heading leaves it out
+  ASSERT_NE(heading, std::string::npos);
+  EXPECT_EQ(text.find("wrong_pose", heading + 5 + 1), std::string::npos);
+  EXPECT_EQ(text.find("cam_c"), std::string::npos);
+  EXPECT_EQ(sim::formatRealImageTargets({c}), "");
+}
+
 TEST(RealImages, Nubot1) {
   const sim::RealImageResult r = run("nubot_1");
   expectHolds(r);
