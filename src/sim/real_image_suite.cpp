@@ -485,7 +485,7 @@ std::string formatRealImageTargets(const std::vector<RealImageResult>& results) 
   std::map<std::string, Tally> totals;
   std::map<std::string, std::vector<std::string>> misses;
   std::ostringstream table;
-  char line[256];
+  char line[512];
   auto cell = [](int met, int of) {
     return of == 0 ? std::string("-") : std::to_string(met) + "/" + std::to_string(of);
   };
