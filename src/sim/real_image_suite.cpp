@@ -476,89 +476,84 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
 }
 
 std::string formatRealImageTargets(const std::vector<RealImageResult>& results) {
-  // Per image and mode: the changes of light that meet white, green, hall, white back, all four.
+  // Per image and mode, of its changes of light: how many meet white, green, hall, white back, all.
   struct Tally {
     std::array<int, 5> met{};
     int changes = 0, with_white = 0;
+    void add(const Tally& t) {
+      for (size_t k = 0; k < met.size(); ++k) met[k] += t.met[k];
+      changes += t.changes;
+      with_white += t.with_white;
+    }
   };
-  std::vector<std::string> modes;
+  auto row = [](const std::string& image, const std::string& mode, const Tally& t) {
+    auto cell = [](int met, int of) {
+      return of == 0 ? std::string("-") : std::to_string(met) + "/" + std::to_string(of);
+    };
+    return "| " + image + " | " + mode + " | " + cell(t.met[0], t.with_white) + " | " + cell(t.met[1], t.changes) +
+           " | " + cell(t.met[2], t.changes) + " | " + cell(t.met[3], t.with_white) + " | " +
+           cell(t.met[4], t.changes) + " |\n";
+  };
+  auto figures = [](const char* what, double before, double after) {
+    char text[64];
+    std::snprintf(text, sizeof(text), "%s %.2f / %.2f", what, before, after);
+    return std::string(text);
+  };
+  std::vector<std::string> modes;  // in the order they first appear
   std::map<std::string, Tally> totals;
   std::map<std::string, std::vector<std::string>> misses;
-  std::ostringstream table;
-  char line[512];
-  auto cell = [](int met, int of) {
-    return of == 0 ? std::string("-") : std::to_string(met) + "/" + std::to_string(of);
-  };
-  auto row = [&](const std::string& image, const std::string& mode, const Tally& t) {
-    table << "| " << image << " | " << mode << " | " << cell(t.met[0], t.with_white) << " | "
-          << cell(t.met[1], t.changes) << " | " << cell(t.met[2], t.changes) << " | " << cell(t.met[3], t.with_white)
-          << " | " << cell(t.met[4], t.changes) << " |\n";
-  };
+  std::string rows;
   for (const RealImageResult& r : results) {
     if (!r.fitted) continue;
     std::map<std::string, Tally> tallies;
-    std::vector<std::string> image_modes;
     for (const RealVariantResult& v : r.rows) {
       if (v.variant == "wrong_pose") continue;
-      if (std::find(image_modes.begin(), image_modes.end(), v.mode) == image_modes.end()) image_modes.push_back(v.mode);
       if (std::find(modes.begin(), modes.end(), v.mode) == modes.end()) modes.push_back(v.mode);
-      Tally& t = tallies[v.mode];
       const bool white = v.before.white_recall >= 0;
       const std::array<bool, 4> ok = {
           !white || std::min(v.before.white_recall, v.after.white_recall) >= kTargetWhiteRecall,
           std::min(v.before.green_recall, v.after.green_recall) >= kTargetGreenRecall,
           std::max(v.before.hall_in_field, v.after.hall_in_field) <= kTargetHallInField,
           !white || (v.white_recovery_cycles >= 0 && v.white_recovery_cycles <= kTargetWhiteBackCycles)};
+      const bool all = ok[0] && ok[1] && ok[2] && ok[3];
+      Tally& t = tallies[v.mode];
       ++t.changes;
       t.with_white += white;
-      for (size_t k = 0; k < ok.size(); ++k) t.met[k] += (k == 0 || k == 3) ? white && ok[k] : ok[k];
-      const bool all = ok[0] && ok[1] && ok[2] && ok[3];
+      t.met[0] += white && ok[0];
+      t.met[1] += ok[1];
+      t.met[2] += ok[2];
+      t.met[3] += white && ok[3];
       t.met[4] += all;
       if (all) continue;
-      std::string why;
-      auto add = [&](const char* text) { why += (why.empty() ? "" : ", ") + std::string(text); };
-      if (!ok[0]) {
-        std::snprintf(line, sizeof(line), "white %.2f / %.2f", v.before.white_recall, v.after.white_recall);
-        add(line);
-      }
-      if (!ok[1]) {
-        std::snprintf(line, sizeof(line), "green %.2f / %.2f", v.before.green_recall, v.after.green_recall);
-        add(line);
-      }
-      if (!ok[2]) {
-        std::snprintf(line, sizeof(line), "hall %.2f / %.2f", v.before.hall_in_field, v.after.hall_in_field);
-        add(line);
-      }
+      std::vector<std::string> why;
+      if (!ok[0]) why.push_back(figures("white", v.before.white_recall, v.after.white_recall));
+      if (!ok[1]) why.push_back(figures("green", v.before.green_recall, v.after.green_recall));
+      if (!ok[2]) why.push_back(figures("hall", v.before.hall_in_field, v.after.hall_in_field));
       if (!ok[3]) {
-        std::snprintf(line, sizeof(line), v.white_recovery_cycles < 0 ? "white never back" : "white back in %d",
-                      v.white_recovery_cycles);
-        add(line);
+        why.push_back(v.white_recovery_cycles < 0 ? "white never back"
+                                                  : "white back in " + std::to_string(v.white_recovery_cycles));
       }
-      misses[v.mode].push_back(r.name + ", " + v.variant + ": " + why);
+      std::string miss = r.name + ", " + v.variant + ": ";
+      for (size_t n = 0; n < why.size(); ++n) miss += (n == 0 ? "" : ", ") + why[n];
+      misses[v.mode].push_back(miss);
     }
-    for (const std::string& mode : image_modes) {
-      const Tally& t = tallies[mode];
-      row(r.name, mode, t);
-      Tally& total = totals[mode];
-      total.changes += t.changes;
-      total.with_white += t.with_white;
-      for (size_t k = 0; k < t.met.size(); ++k) total.met[k] += t.met[k];
+    for (const std::string& mode : modes) {
+      const auto it = tallies.find(mode);
+      if (it == tallies.end()) continue;
+      rows += row(r.name, mode, it->second);
+      totals[mode].add(it->second);
     }
   }
   if (modes.empty()) return "";
   std::ostringstream out;
+  char line[512];
   std::snprintf(line, sizeof(line),
                 "Issue 12's targets on each change of light (not wrong_pose): white recall >= %.2f on the hand-picked "
                 "pixels, green >= %.2f, hall in a field class <= %.2f, before and after; white back within %d "
                 "cycles. Changes that meet them:\n\n",
                 kTargetWhiteRecall, kTargetGreenRecall, kTargetHallInField, kTargetWhiteBackCycles);
-  out << line << "| image | mode | white | green | hall | white back | all |\n|---|---|---|---|---|---|---|\n"
-      << table.str();
-  for (const std::string& mode : modes) {
-    table.str("");
-    row("all images", mode, totals[mode]);
-    out << table.str();
-  }
+  out << line << "| image | mode | white | green | hall | white back | all |\n|---|---|---|---|---|---|---|\n" << rows;
+  for (const std::string& mode : modes) out << row("all images", mode, totals[mode]);
   out << "\n";
   for (const std::string& mode : modes) {
     if (misses[mode].empty()) continue;
