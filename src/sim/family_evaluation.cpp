@@ -37,14 +37,15 @@ void writePanel(const std::string& path, const cv::Mat& rgb, const std::vector<c
   cv::imwrite(path, row);
 }
 
-// Segments that start with a sudden change of light (settle cycles are measured after those; a
+// Segments that start with a sudden change of light, global or local (settle cycles are measured after those; a
 // slow ramp, an exposure swing, a wrong pose or driving change what the frames show all along).
 bool startsWithSuddenChange(const std::string& event) {
   size_t begin = 0;
   while (begin <= event.size()) {
     const size_t end = std::min(event.find('+', begin), event.size());
     const std::string part = event.substr(begin, end - begin);
-    if (isNamedToneChange(part) || familyEventKind(part) == "tone") return true;
+    const std::string kind = familyEventKind(part);
+    if (isNamedToneChange(part) || kind == "tone" || kind == "local") return true;
     begin = end + 1;
   }
   return false;

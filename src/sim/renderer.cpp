@@ -411,9 +411,9 @@ LabeledFrame Renderer::render(const Scene& scene) const {
       const double dx = x - s.x_m, dy = y - s.y_m;
       l += s.gain * std::exp(-(dx * dx + dy * dy) / (2.0 * s.radius_m * s.radius_m));
     }
-    if (on_floor) {
-      for (const Shadow& s : light.shadows) {
-        if (x >= s.x_min_m && x <= s.x_max_m && y >= s.y_min_m && y <= s.y_max_m) l *= s.factor;
+    for (const Shadow& s : light.shadows) {
+      if ((on_floor || !s.floor_only) && x >= s.x_min_m && x <= s.x_max_m && y >= s.y_min_m && y <= s.y_max_m) {
+        l *= s.factor;
       }
     }
     return static_cast<float>(l);

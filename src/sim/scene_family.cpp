@@ -413,7 +413,7 @@ double distanceToPoses(double x, double y, const std::vector<core::Pose2D>& pose
 // ---------------------------------------------------------------------------------------------
 // Events
 
-enum class Kind { kDarken, kGain, kGamma, kWarm, kBrighten, kTone, kSlow, kAutoExposure, kWrongPose, kDrive };
+enum class Kind { kDarken, kGain, kGamma, kWarm, kBrighten, kTone, kSlow, kAutoExposure, kWrongPose, kDrive, kLocal };
 
 struct Event {
   Kind kind;
@@ -424,6 +424,7 @@ struct Event {
   int duration = 0;            // frames of a ramp, a swing, a wrong pose
   double period_frames = 8.0;  // auto exposure
   double settle = 1.0;         // auto exposure's final value
+  Shadow zone;                 // a local change: the light of this zone from the event's frame on
 };
 
 // Per-frame light level and exposure multipliers and the tone curve of the events so far.
@@ -431,6 +432,7 @@ struct Photometry {
   double level = 1.0;
   double exposure = 1.0;
   ToneCurve transfer;
+  std::vector<Shadow> zones;  // local changes
 };
 
 Photometry photometryAt(const std::vector<Event>& events, int frame) {
@@ -464,6 +466,9 @@ Photometry photometryAt(const std::vector<Event>& events, int frame) {
         }
         break;
       }
+      case Kind::kLocal:
+        p.zones.push_back(e.zone);
+        break;
       case Kind::kWrongPose:
       case Kind::kDrive:
         break;
@@ -530,7 +535,36 @@ Event drawEvent(Draw& draw, int frame, int named_kind, bool can_drive, bool can_
     case Kind::kDrive:
       e.name = "drive";
       break;
+    case Kind::kLocal:  // made from a sudden change by localChange
+      break;
   }
+  return e;
+}
+
+// A sudden change made local (LightEvents::kLocal): the light beyond a line across the field, on
+// everything there, multiplied by 0.25-0.6 (lamps over one part off, a window's sun gone) or by
+// 1.4-1.8 (the sun out), from the event's frame on. The line lies within the middle 60% of the
+// field along x or y; the zone reaches beyond the hall on its side.
+Event localChange(Draw& draw, const Event& sudden, const core::FieldCalibration& f) {
+  Event e = sudden;
+  e.kind = Kind::kLocal;
+  const bool along_x = draw.chance(0.5);
+  const int side = draw.sign();
+  const double half = (along_x ? f.length_m : f.width_m) / 2;
+  const double line = draw.uniform(-0.3, 0.3) * 2 * half;
+  e.zone.factor = draw.chance(0.6) ? draw.uniform(0.25, 0.6) : draw.uniform(1.4, 1.8);
+  e.zone.floor_only = false;
+  constexpr double kFar = 1e3;
+  double& lo = along_x ? e.zone.x_min_m : e.zone.y_min_m;
+  double& hi = along_x ? e.zone.x_max_m : e.zone.y_max_m;
+  lo = side > 0 ? line : -kFar;
+  hi = side > 0 ? kFar : line;
+  (along_x ? e.zone.y_min_m : e.zone.x_min_m) = -kFar;
+  (along_x ? e.zone.y_max_m : e.zone.x_max_m) = kFar;
+  char text[64];
+  std::snprintf(text, sizeof(text), "local:%c%c%.1f*%.2f", along_x ? 'x' : 'y', side > 0 ? '>' : '<', line,
+                e.zone.factor);
+  e.name = text;
   return e;
 }
 
@@ -561,7 +595,7 @@ double wrongPoseDirection(Draw& draw, const std::vector<core::Pose2D>& truths, c
 const std::vector<std::string>& familyEventKinds() {
   static const std::vector<std::string> kKinds = {"darken",     "gain_0.5", "gamma_1.6",   "warm_white_balance",
                                                   "brighten",   "tone",     "slow_change", "auto_exposure",
-                                                  "wrong_pose", "drive"};
+                                                  "wrong_pose", "drive",    "local"};
   return kKinds;
 }
 
@@ -573,7 +607,7 @@ bool isNamedToneChange(const std::string& event) {
   return std::find(kinds.begin(), kinds.begin() + 5, kind) != kinds.begin() + 5;
 }
 
-FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length, bool ball_looks) {
+FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length, bool ball_looks, LightEvents light_events) {
   Draw draw(seed);
   FamilyScene out;
   out.seed = seed;
@@ -637,6 +671,13 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length, bool ball_look
       d.name = "drive";
       events.push_back(d);
       has_drive = true;
+    }
+  }
+  if (light_events == LightEvents::kLocal) {
+    // From a generator of its own: the scene is otherwise the global one's.
+    Draw local(seed * 2246822519u + 0x10ca1u);
+    for (Event& e : events) {
+      if (e.kind <= Kind::kTone) e = localChange(local, e, field);  // the five named changes and tone curves
     }
   }
   int drive_start = driving_from_start ? 0 : total;
@@ -760,6 +801,7 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length, bool ball_look
     f.scene.lighting.level *= p.level;
     f.scene.lighting.exposure *= p.exposure;
     f.scene.lighting.transfer = p.transfer;
+    f.scene.lighting.shadows.insert(f.scene.lighting.shadows.end(), p.zones.begin(), p.zones.end());
     f.scene.noise_seed = seed * 100003u + static_cast<uint32_t>(i) * 7919u + 1u;
     for (const Event& e : events) {
       if (e.frame == i) {

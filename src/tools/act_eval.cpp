@@ -3,7 +3,7 @@
 // paper's algorithm side by side, the fixed-table ceiling of every scene segment, the gaps to it,
 // the cycles to settle after each event, and where the defaults fall below the paper.
 //   act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full] [--ablate]
-//            [--per-scene] [--png DIR] [--false-pixels]
+//            [--local-light] [--per-scene] [--png DIR] [--false-pixels]
 // Tune on the tuning split (seeds 0-99); the report split (1000-1099) is for reporting only.
 #include <chrono>
 #include <cstdio>
@@ -22,13 +22,15 @@ namespace sim = act_color::sim;
 
 const char* const kUsage =
     "usage: act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full]\n"
-    "                [--ablate] [--set NAME=VALUE] [--mode NAME:N=V,...] [--per-scene] [--png DIR]\n"
-    "                [--false-pixels]\n"
+    "                [--ablate] [--local-light] [--set NAME=VALUE] [--mode NAME:N=V,...] [--per-scene]\n"
+    "                [--png DIR] [--false-pixels]\n"
     "  --split S     report: seeds 1000-1099 (default); tuning: seeds 0-99\n"
     "  --seeds A-B   any range of seeds instead (inclusive)\n"
     "  --count N     only the first N seeds of the range (a quick subset)\n"
     "  --length L    small (default, 40-60 frames per scene) or full\n"
     "  --ablate      also the defaults with each extension off in turn\n"
+    "  --local-light the same scenes with each sudden change of light made local: the light on one\n"
+    "                side of a line across the field x0.25-0.6 or x1.4-1.8 (events 'local:...')\n"
     "  --set N=V     an ACT parameter for every mode but the paper's (repeatable), e.g. zeta=3\n"
     "  --mode M:N=V,N=V  one more mode: the defaults with these parameters (repeatable)\n"
     "  --per-scene   one line per scene and segment: F1 per class and mode, [ceiling]\n"
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
   long count = -1;
   sim::ScenarioLength length = sim::ScenarioLength::kSmall;
   bool ablate = false, per_scene = false;
+  sim::LightEvents light_events = sim::LightEvents::kGlobal;
   sim::EvalOptions options;
   std::vector<std::string> overrides;  // --set name=value
   std::vector<std::string> extra_modes;
@@ -86,6 +89,8 @@ int main(int argc, char** argv) {
         if (!sim::parseScenarioLength(value(), &length)) return usage("--length is small or full");
       } else if (arg == "--ablate") {
         ablate = true;
+      } else if (arg == "--local-light") {
+        light_events = sim::LightEvents::kLocal;
       } else if (arg == "--per-scene") {
         per_scene = true;
       } else if (arg == "--set") {
@@ -134,7 +139,7 @@ int main(int argc, char** argv) {
   double render = 0, act = 0;
   size_t frames = 0;
   for (uint32_t seed = first; seed < end; ++seed) {
-    const sim::FamilyScene scene = sim::makeFamilyScene(seed, length);
+    const sim::FamilyScene scene = sim::makeFamilyScene(seed, length, true, light_events);
     results.push_back(sim::evaluateScene(scene, modes, options));
     render += results.back().render_seconds;
     act += results.back().act_seconds;

@@ -272,6 +272,22 @@ TEST(Renderer, LightingChangesTheColorsNotTheTruth) {
   ASSERT_TRUE(projectFieldPoint(camera, scene.robot_pose, 2.5, 0.7, 0.0, &out));
   EXPECT_LT(colorAt(s, in)[1], 0.8 * colorAt(normal, in)[1]);
   EXPECT_EQ(colorAt(s, out), colorAt(normal, out));
+  // The floor's shadow leaves the goal behind it as it was; a zone of the hall's light (lamps over
+  // one half off: floor_only false) darkens the goal too.
+  const double goal_x = renderer.model().field().halfLength() + 0.1;
+  Pixel goal;
+  ASSERT_TRUE(projectFieldPoint(camera, scene.robot_pose, goal_x, 0.0, 0.3, &goal));
+  ASSERT_EQ(labelAt(normal, goal), core::kYellow);
+  Scene half = scene;
+  half.lighting.shadows = {{1.0, -1e3, 1e3, 1e3, 0.4, false}};
+  shadowed.lighting.shadows = {{1.0, -1e3, 1e3, 1e3, 0.4}};
+  const LabeledFrame h = renderer.render(half), floor_only = renderer.render(shadowed);
+  EXPECT_EQ(colorAt(floor_only, goal), colorAt(normal, goal));
+  EXPECT_LT(colorAt(h, goal)[0], 0.8 * colorAt(normal, goal)[0]);
+  EXPECT_LT(colorAt(h, in)[1], 0.8 * colorAt(normal, in)[1]);
+  Pixel behind;  // the other half
+  ASSERT_TRUE(projectFieldPoint(camera, scene.robot_pose, -1.5, 0.7, 0.0, &behind));
+  EXPECT_EQ(colorAt(h, behind), colorAt(normal, behind));
 
   // Warm light: more red relative to blue on the white lines.
   Scene warm = scene;

@@ -289,7 +289,52 @@ TEST(SceneFamily, TheReportSeedsCoverTheFamily) {
   EXPECT_EQ(signs.size(), 2u);
   EXPECT_EQ(struts.size(), 2u);
   EXPECT_EQ(profiles.size(), 4u);
-  for (const std::string& kind : sim::familyEventKinds()) EXPECT_TRUE(kinds.count(kind)) << kind;
+  for (const std::string& kind : sim::familyEventKinds())
+    EXPECT_EQ(kinds.count(kind), kind == "local" ? 0u : 1u) << kind;
+}
+
+// LightEvents::kLocal: the same scenes with each sudden change made local. Everything else is the
+// global scene's; the light changes on one side of a line across the field and not on the other.
+TEST(SceneFamily, LocalChangesLightOnePartAndLeaveTheRestOfTheScene) {
+  int local_events = 0;
+  for (uint32_t seed = 0; seed < 10; ++seed) {
+    const FamilyScene global = makeFamilyScene(seed);
+    const FamilyScene local = makeFamilyScene(seed, sim::ScenarioLength::kSmall, true, sim::LightEvents::kLocal);
+    EXPECT_EQ(global.calibration.camera.width, local.calibration.camera.width);
+    ASSERT_EQ(global.scenario.frames.size(), local.scenario.frames.size()) << seed;
+    for (size_t i = 0; i < global.scenario.frames.size(); ++i) {
+      const auto& g = global.scenario.frames[i];
+      const auto& l = local.scenario.frames[i];
+      EXPECT_DOUBLE_EQ(g.scene.robot_pose.x_m, l.scene.robot_pose.x_m);
+      EXPECT_DOUBLE_EQ(g.told_pose.theta_rad, l.told_pose.theta_rad);
+      ASSERT_EQ(g.events.size(), l.events.size());
+      for (size_t k = 0; k < g.events.size(); ++k) {
+        const bool sudden = sim::isNamedToneChange(g.events[k]) || sim::familyEventKind(g.events[k]) == "tone";
+        EXPECT_EQ(sim::familyEventKind(l.events[k]), sudden ? "local" : g.events[k]) << l.events[k];
+        local_events += sudden;
+      }
+      // No global tone change; one zone per local change so far, on everything in it.
+      EXPECT_TRUE(l.scene.lighting.transfer.isIdentity());
+      const size_t added = l.scene.lighting.shadows.size() - g.scene.lighting.shadows.size();
+      size_t so_far = 0;
+      for (size_t j = 0; j <= i; ++j) {
+        for (const std::string& e : local.scenario.frames[j].events) so_far += sim::familyEventKind(e) == "local";
+      }
+      EXPECT_EQ(added, so_far);
+      for (size_t z = g.scene.lighting.shadows.size(); z < l.scene.lighting.shadows.size(); ++z) {
+        const sim::Shadow& zone = l.scene.lighting.shadows[z];
+        EXPECT_FALSE(zone.floor_only);
+        EXPECT_TRUE((zone.factor >= 0.25 && zone.factor <= 0.6) || (zone.factor >= 1.4 && zone.factor <= 1.8));
+        // The line crosses the field: some of the field lies on each side.
+        const core::FieldCalibration& f = local.calibration.field;
+        const bool x_line = zone.y_min_m < -100 && zone.y_max_m > 100;
+        const double line = x_line ? (zone.x_min_m > -100 ? zone.x_min_m : zone.x_max_m)
+                                   : (zone.y_min_m > -100 ? zone.y_min_m : zone.y_max_m);
+        EXPECT_LT(std::abs(line), 0.31 * (x_line ? f.length_m : f.width_m));
+      }
+    }
+  }
+  EXPECT_GE(local_events, 5);
 }
 
 }  // namespace

@@ -51,10 +51,14 @@ struct Spotlight {
   double gain = 0.8;
 };
 
-// A hard shadow: light multiplied by `factor` inside an axis-aligned rectangle of the floor.
+// A hard shadow: light multiplied by `factor` inside an axis-aligned rectangle of the floor. With
+// `floor_only` false, a zone of the hall's lighting: the light on everything inside the rectangle
+// (floor, robots, people, hall objects; the walls by where they stand) is multiplied, as when the
+// lamps over one half go off or a window's sun goes behind a cloud (`factor` may exceed 1).
 struct Shadow {
   double x_min_m = 0.0, y_min_m = 0.0, x_max_m = 0.0, y_max_m = 0.0;
   double factor = 0.5;
+  bool floor_only = true;
 };
 
 // Illumination and camera photometry.

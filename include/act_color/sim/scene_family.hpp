@@ -28,10 +28,18 @@ struct FamilyScene {
   Scenario scenario;              // frames, the poses ACT is told, events
 };
 
+// How the family's sudden changes of light act: kGlobal, on the whole image (tone curves: a camera
+// setting, all the hall's lamps); kLocal, on one part of the field and hall (the light beyond a
+// line across the field multiplied by 0.25-0.6 or 1.4-1.8: lamps over one half off, a window's
+// sun gone or out; events "local:<axis><side><line m>*<factor>"). Everything else about a scene,
+// its other events included, is the same either way.
+enum class LightEvents { kGlobal, kLocal };
+
 // `ball_looks` false: the ball orange, plain and where it was, no team markers, no poster of the
 // ball's color (the scenes as they were before issue 13; act_calibrate's simulator check was
 // developed on those).
-FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length = ScenarioLength::kSmall, bool ball_looks = true);
+FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length = ScenarioLength::kSmall, bool ball_looks = true,
+                            LightEvents light_events = LightEvents::kGlobal);
 
 // The kinds of the family's events (ScenarioFrame::events), in a fixed order. The first five are
 // the named sudden changes (tone curves from the event's frame on): "darken" (the paper's
@@ -40,7 +48,8 @@ FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length = ScenarioLengt
 // Then "tone" (events "tone:<description>", a ToneCurve::random), "slow_change" (light level
 // ramp over ~30 frames, 90 in kFull), "auto_exposure" (exposure swinging 0.7-1.3, then settling),
 // "wrong_pose" (told pose 2.5 m off and rotated 165 degrees for some frames, paper 3.3) and
-// "drive" (a static robot starts driving; told poses get a few cm of noise).
+// "drive" (a static robot starts driving; told poses get a few cm of noise); "local" (events
+// "local:..." of LightEvents::kLocal, in place of the sudden changes).
 const std::vector<std::string>& familyEventKinds();
 // The kind of an event name: the text before ':' ("tone:gain0.62" -> "tone").
 std::string familyEventKind(const std::string& event);
