@@ -75,6 +75,18 @@ TEST(FamilyEvaluation, DefaultsPaperAndCeilingOnTwoScenes) {
   EXPECT_EQ(report.false_hall[0][core::kWhite].count, report.precision[0][core::kWhite].count);
 }
 
+// act_eval --local-light: seed 0's darkening made local; its segment is measured as a sudden change.
+TEST(FamilyEvaluation, ALocalChangeIsASuddenChange) {
+  const sim::SceneResult r = sim::evaluateScene(
+      sim::makeFamilyScene(sim::kTuningSeedsBegin, sim::ScenarioLength::kSmall, true, sim::LightEvents::kLocal),
+      sim::evalModes(false), sim::EvalOptions{});
+  const std::string scene = sim::formatScene(r);
+  EXPECT_NE(scene.find("segment 'local:"), std::string::npos) << scene;
+  EXPECT_EQ(scene.find("segment 'darken'"), std::string::npos) << scene;
+  EXPECT_NE(scene.find("    settle  green "), std::string::npos) << scene;
+  EXPECT_EQ(sim::summarize({r}).settle[0][core::kGreen].count, 1u);
+}
+
 TEST(FamilyEvaluation, ALongSceneSummaryIsPrintedWholeOnItsOwnLine) {
   // Composed light events make summaries longer than one print buffer (report seed 1052's was
   // cut and ran into its first segment's line).

@@ -462,6 +462,11 @@ TEST(ActEval, OneSceneReportAndFamilyBag) {
   for (const char* needle : {"seeds 0-0 (1 scenes", "defaults", "paper", "ceiling", "F1 below the paper"}) {
     EXPECT_NE(text.find(needle), std::string::npos) << needle << " not in:\n" << text;
   }
+  const std::string local = tempDir() + "/eval_local.txt";
+  ASSERT_EQ(std::system((eval + " --seeds 0-0 --local-light --per-scene > " + local + " 2> /dev/null").c_str()), 0);
+  std::ifstream local_in(local);
+  const std::string local_text((std::istreambuf_iterator<char>(local_in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(local_text.find("segment 'local:"), std::string::npos) << local_text;
   EXPECT_EQ(WEXITSTATUS(std::system((eval + " --split nonsense 2> /dev/null").c_str())), 2);
   EXPECT_EQ(WEXITSTATUS(std::system((eval + " --set zeta=-1 2> /dev/null").c_str())), 2);
 
