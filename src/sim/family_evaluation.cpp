@@ -37,8 +37,9 @@ void writePanel(const std::string& path, const cv::Mat& rgb, const std::vector<c
   cv::imwrite(path, row);
 }
 
-// Segments that start with a sudden change of light, global or local (settle cycles are measured after those; a
-// slow ramp, an exposure swing, a wrong pose or driving change what the frames show all along).
+// Segments that start with a sudden change of light, global or local (settle cycles are measured
+// after those; a slow ramp, an exposure swing, a wrong pose or driving change what the frames show
+// all along).
 bool startsWithSuddenChange(const std::string& event) {
   size_t begin = 0;
   while (begin <= event.size()) {
