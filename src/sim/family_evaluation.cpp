@@ -45,8 +45,7 @@ bool startsWithSuddenChange(const std::string& event) {
   while (begin <= event.size()) {
     const size_t end = std::min(event.find('+', begin), event.size());
     const std::string part = event.substr(begin, end - begin);
-    const std::string kind = familyEventKind(part);
-    if (isNamedToneChange(part) || kind == "tone" || kind == "local") return true;
+    if (isSuddenChange(part)) return true;
     begin = end + 1;
   }
   return false;

@@ -552,15 +552,11 @@ Event localChange(Draw& draw, const Event& sudden, const core::FieldCalibration&
   const int side = draw.sign();
   const double half = (along_x ? f.length_m : f.width_m) / 2;
   const double line = draw.uniform(-0.3, 0.3) * 2 * half;
-  e.zone.factor = draw.chance(0.6) ? draw.uniform(0.25, 0.6) : draw.uniform(1.4, 1.8);
-  e.zone.floor_only = false;
+  const double factor = draw.chance(0.6) ? draw.uniform(0.25, 0.6) : draw.uniform(1.4, 1.8);
   constexpr double kFar = 1e3;
-  double& lo = along_x ? e.zone.x_min_m : e.zone.y_min_m;
-  double& hi = along_x ? e.zone.x_max_m : e.zone.y_max_m;
-  lo = side > 0 ? line : -kFar;
-  hi = side > 0 ? kFar : line;
-  (along_x ? e.zone.y_min_m : e.zone.x_min_m) = -kFar;
-  (along_x ? e.zone.y_max_m : e.zone.x_max_m) = kFar;
+  e.zone = Shadow{-kFar, -kFar, kFar, kFar, factor, /*floor_only=*/false};
+  // The line is the zone's one near edge.
+  (along_x ? (side > 0 ? e.zone.x_min_m : e.zone.x_max_m) : (side > 0 ? e.zone.y_min_m : e.zone.y_max_m)) = line;
   char text[64];
   std::snprintf(text, sizeof(text), "local:%c%c%.1f*%.2f", along_x ? 'x' : 'y', side > 0 ? '>' : '<', line,
                 e.zone.factor);
@@ -605,6 +601,11 @@ bool isNamedToneChange(const std::string& event) {
   const std::string kind = familyEventKind(event);
   const auto& kinds = familyEventKinds();
   return std::find(kinds.begin(), kinds.begin() + 5, kind) != kinds.begin() + 5;
+}
+
+bool isSuddenChange(const std::string& event) {
+  const std::string kind = familyEventKind(event);
+  return isNamedToneChange(event) || kind == "tone" || kind == "local";
 }
 
 FamilyScene makeFamilyScene(uint32_t seed, ScenarioLength length, bool ball_looks, LightEvents light_events) {

@@ -55,6 +55,8 @@ const std::vector<std::string>& familyEventKinds();
 std::string familyEventKind(const std::string& event);
 // True for the five named sudden changes.
 bool isNamedToneChange(const std::string& event);
+// True for every sudden change of light: the named ones, "tone" and "local".
+bool isSuddenChange(const std::string& event);
 
 // The fixed split of issue 11: tune on [0, 100), report on [1000, 1100).
 constexpr uint32_t kTuningSeedsBegin = 0, kTuningSeedsEnd = 100;
