@@ -33,6 +33,12 @@ constexpr double kDarkFraction = 0.8;
 constexpr double kGoalMinChromaOfCarpet = 0.5;
 // robots_train_black measures the carpet (its spread, its color) from at least this many samples.
 constexpr size_t kMinCarpetSamples = 20;
+// robots_train_black: the field lies partly in a shadow (ActTrainer::measureCarpetShade) when more
+// than this share of the carpet samples are colors of the carpet's hue well below the lit carpet
+// (no robot is that color, and none covers a tenth of the carpet in view), within
+// kShadedCarpetHueSpreads of the carpet's spread across its hue.
+constexpr double kShadedCarpetShare = 0.1;
+constexpr double kShadedCarpetHueSpreads = 1.0;
 constexpr double kMinAnchorSpan = 15.0;
 
 // A cell confirmed again within this many cycles does not fill its neighbourhood again.
@@ -276,6 +282,7 @@ void ActTrainer::reset(ColorSpace space) {
   dark_position_ = -1;
   dark_frozen_ = false;
   carpet_spread_ = -1;
+  carpet_shaded_ = false;
   light_states_.clear();
   last_light_change_ = 0;
   restartPoseCheck();
@@ -579,6 +586,7 @@ uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3], double dark_limi
   const int hi = std::max({c[0], c[1], c[2]});
   if (hi - lo > 0.35 * hi + 8) return k;
   const Eigen::Vector3d color(c[0], c[1], c[2]);
+  if (k == kGreen && shadedCarpet(color)) return k;
   // Far from the carpet: beyond zeta times its own spread (green's sigma when that is smaller).
   const double sigma = carpet_spread_ > 0 ? std::min(green.sigma(), carpet_spread_) : green.sigma();
   return (color - green.mean()).norm() > params_.zeta * sigma ? static_cast<uint8_t>(kBlack) : k;
@@ -625,6 +633,58 @@ void ActTrainer::measureCarpetColor() {
     median[ch] = *middle;
   }
   goal_min_chroma_ = kGoalMinChromaOfCarpet * chroma(median, lut_.colorSpace());
+}
+
+void ActTrainer::measureCarpetShade() {
+  // A robot is grey or black; the carpet in a shadow (the lamps over one half of the field off, a
+  // window's sun gone) is the carpet's color at a lower light: on the line from the pivot of a gain
+  // (black) through green's mean, well below the lit carpet. Beyond the carpet's spread about its
+  // mean, the shadow's colors trained black as a robot's would, and the nearest-mean rule gave them
+  // to black or a shaded goal (their chroma is a fraction of the carpet's). Both measures along the
+  // line are robust to a shadow over less than half of the carpet: the median and the median
+  // absolute deviation; the spread across the line does not grow with the shadow at all.
+  carpet_shaded_ = false;
+  if (!carpetMeasurable() || !clusters_[kGreen].trained()) return;
+  const Eigen::Vector3f pivot = LightModel::pivot(lut_.colorSpace()).cast<float>();
+  hue_axis_ = (clusters_[kGreen].mean() - pivot.cast<double>()).normalized();
+  const Eigen::Vector3f axis = hue_axis_.cast<float>();
+  auto median = [this](size_t rank) {
+    const auto at = carpet_values_.begin() + static_cast<long>(rank);
+    std::nth_element(carpet_values_.begin(), at, carpet_values_.end());
+    return static_cast<double>(*at);
+  };
+  const size_t n = carpet_samples_.size();
+  carpet_values_.clear();
+  for (const Eigen::Vector3f& c : carpet_samples_) {
+    const Eigen::Vector3f d = c - pivot;
+    carpet_values_.push_back((d - d.dot(axis) * axis).norm());
+  }
+  carpet_hue_spread_ = std::max(median(n * 3 / 4), params_.sigma_min);
+  carpet_values_.clear();
+  for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back((c - pivot).dot(axis));
+  const double middle = median(n / 2);
+  for (float& t : carpet_values_) t = std::abs(t - static_cast<float>(middle));
+  constexpr double kNormalSigmaOverMedianDeviation = 1.4826;
+  const double spread_along = std::max(kNormalSigmaOverMedianDeviation * median(n / 2), params_.sigma_min);
+  shade_below_ = middle - params_.zeta * spread_along;
+  size_t shaded = 0;
+  for (const Eigen::Vector3f& c : carpet_samples_) shaded += carpetHue(c.cast<double>());
+  carpet_shaded_ = shaded > kShadedCarpetShare * n;
+}
+
+bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const { return carpet_shaded_ && carpetHue(c); }
+
+bool ActTrainer::carpetHue(const Eigen::Vector3d& c) const {
+  const Eigen::Vector3d d = c - LightModel::pivot(lut_.colorSpace());
+  const double t = d.dot(hue_axis_);
+  if (t >= shade_below_) return false;
+  // Towards the pivot the line nears the greys (a robot's colors): its point at t must lie farther
+  // from them than the tolerance, or a grey would pass for the carpet's hue.
+  const double tolerance = kShadedCarpetHueSpreads * carpet_hue_spread_;
+  const double grey_distance = lut_.colorSpace() == ColorSpace::kYuv
+                                   ? hue_axis_.tail<2>().norm()
+                                   : (hue_axis_ - Eigen::Vector3d::Constant(hue_axis_.mean())).norm();
+  return t * grey_distance > tolerance && (d - t * hue_axis_).norm() <= tolerance;
 }
 
 double ActTrainer::darkLimit() const {
@@ -695,6 +755,9 @@ bool ActTrainer::goalColor(uint8_t k, const Eigen::Vector3f& c) const {
 }
 
 bool ActTrainer::nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const {
+  // The carpet's hue decides for a shaded carpet color: its chroma is a fraction of the carpet's,
+  // nearer to a grey's or a shaded goal's.
+  if (k == kGreen && shadedCarpet(color)) return false;
   for (const MeanBoundary& b : mean_boundaries_[k]) {
     if (b.normal.dot(color) < b.offset) return true;
   }
@@ -1049,6 +1112,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   }
 
   measureCarpetSpread();
+  measureCarpetShade();
   markAbsentGoals(stats);
   if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.

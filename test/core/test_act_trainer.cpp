@@ -993,3 +993,39 @@ TEST_F(ActTrainerTest, AGoalMostlyHiddenByGreyRobotsKeepsItsColor) {
     EXPECT_GT(m.precision(kYellow), 0.9) << "seed " << seed;
   }
 }
+
+TEST_F(ActTrainerTest, TheCarpetInAShadowStaysCarpetBesideDarkRobots) {
+  // The lamps over one side of the field are off: beyond an image column everything has a quarter
+  // of its light, 12-25% of the carpet in view, while dark grey robots stand on the lit carpet. The
+  // shadow's carpet is darker than the robots' grey and far from the lit carpet's mean; it is the
+  // carpet's color at a lower light (its hue), which no robot is: it stays green, the robots black.
+  // Without measureCarpetShade the shadow trained black (green recall 0.82, black precision 0.35).
+  auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  const cv::Vec3b chassis = colorOf(frame.rgb, pose, kBlack);
+  const auto lift = [](uint8_t c) { return static_cast<uint8_t>(std::min(255, c + 13)); };
+  const cv::Vec3b robot(lift(chassis[0]), lift(chassis[1]), lift(chassis[2]));
+  const auto [green_pixels, covered] = paintWedges(frame, pose, kGreen, 60.0, 4.0, robot);
+  ASSERT_GT(covered, green_pixels / 20);
+  int column = 579, shaded = 0;
+  while (shaded < green_pixels / 6) {
+    for (int v = 0; v < 580; ++v) {
+      cv::Vec3b& c = frame.rgb.at<cv::Vec3b>(v, column);
+      if (frame.labels.at<uint8_t>(v, column) == kGreen && c != robot) ++shaded;
+      for (int ch = 0; ch < 3; ++ch) c[ch] = static_cast<uint8_t>(std::lround(0.25 * c[ch]));
+    }
+    --column;
+  }
+  ASSERT_LT(shaded, green_pixels / 4);
+  for (uint32_t seed = 1; seed <= 3; ++seed) {
+    ActParams p;
+    p.seed = seed;
+    ActTrainer trainer(cal, p);
+    trainer.bootstrap(view(frame.rgb), pose, 20);
+    for (int i = 0; i < 20; ++i) trainer.cycle(view(frame.rgb), pose);
+    EXPECT_EQ(trainer.lut().classOf(robot[0], robot[1], robot[2]), kBlack) << "seed " << seed;
+    const ClassificationMetrics m = evaluate(trainer, frame, cal);
+    EXPECT_GT(m.recall(kGreen), 0.95) << "seed " << seed;
+    EXPECT_GT(m.recall(kBlack), 0.9) << "seed " << seed;
+    EXPECT_GT(m.precision(kBlack), 0.9) << "seed " << seed;
+  }
+}

@@ -229,6 +229,7 @@ class ActTrainer {
   uint32_t addColor(const uint8_t c[3], uint8_t k, bool ball_sighting = false);
   // ActParams::nearest_mean: another trained cluster's mean is nearer to the color than k's.
   // Uses the boundaries from prepareNearestMean(), made after this cycle's cluster update.
+  // Not for a shaded carpet color (shadedCarpet).
   bool nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const;
   void prepareNearestMean();
   // ActParams::nearest_mean: a goal whose cluster mean lies nearer to white's than
@@ -256,6 +257,16 @@ class ActTrainer {
   void measureCarpetSpread();
   // robots_train_black's least chroma of a goal's color, of the carpet's color this cycle.
   void measureCarpetColor();
+  // robots_train_black's shade of the carpet: whether a part of the field lies in a shadow this
+  // cycle (carpet_shaded_), from the carpet samples that are dark colors of the carpet's own hue.
+  void measureCarpetShade();
+  // A color of the carpet's hue in a shadow: within kShadedCarpetHueSpreads of the carpet's spread
+  // across the line from black (LightModel::pivot) through green's mean, where the line lies
+  // farther than that from the greys, and below the carpet's median along it by more than zeta
+  // times its spread there.
+  bool carpetHue(const Eigen::Vector3d& c) const;
+  // Such a color while carpet_shaded_: carpet in a shadow, not a robot.
+  bool shadedCarpet(const Eigen::Vector3d& c) const;
   // False for a color of a goal sample (k yellow or blue) that is no goal's color.
   bool goalColor(uint8_t k, const Eigen::Vector3f& c) const;
   // Light compensation (after 2.2's samples, before the clusters move): observes the anchors, and
@@ -341,6 +352,13 @@ class ActTrainer {
   // scratch of its measurements (the samples' distances, one channel of their colors).
   double carpet_spread_ = -1;
   std::vector<float> carpet_values_;
+  // measureCarpetShade: the carpet's hue (unit vector from the pivot), its spread across that line
+  // (upper quartile of the samples' distances from it), the position along it below which a color
+  // is in a shadow, and whether more than kShadedCarpetShare of its samples are.
+  Eigen::Vector3d hue_axis_ = Eigen::Vector3d::Zero();
+  double carpet_hue_spread_ = 0;
+  double shade_below_ = 0;
+  bool carpet_shaded_ = false;
   double goal_min_chroma_ = 0;  // goalColor's least chroma, of this cycle's carpet (measureCarpetColor)
   LightModel light_;
   std::vector<uint8_t> warped_;
