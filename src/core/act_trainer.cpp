@@ -458,6 +458,13 @@ Eigen::Matrix3d meanMetric(ColorSpace space) {
 // How far a color lies from grey: the largest minus the smallest channel in RGB, |U - 128| +
 // |V - 128| in YUV. A change of gain, brightness, contrast or white balance scales it for every
 // color alike, about.
+// BT.601 full range, as core::rgbToUyvy: in YUV a dark grey's channels ((41, 128, 128)) are far
+// apart, and robots_train_black's "unsaturated" is a property of its RGB color.
+Eigen::Vector3d yuvToRgb(const Eigen::Vector3d& yuv) {
+  const double u = yuv[1] - 128.0, v = yuv[2] - 128.0;
+  return {yuv[0] + 1.402 * v, yuv[0] - 0.344136 * u - 0.714136 * v, yuv[0] + 1.772 * u};
+}
+
 double chroma(const Eigen::Vector3f& c, ColorSpace space) {
   if (space == ColorSpace::kYuv) return std::abs(c[1] - 128.f) + std::abs(c[2] - 128.f);
   return c.maxCoeff() - c.minCoeff();
@@ -580,12 +587,10 @@ uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3], double dark_limi
   if ((k != kGreen && k != kYellow && k != kBlue) || !params_.robots_train_black) return k;
   const ClassCluster& green = clusters_[kGreen];
   if (!green.trained()) return k;
-  const double intensity = c[0] + c[1] + c[2];
-  if (intensity >= dark_limit) return k;  // most samples: the carpet is brighter
-  const int lo = std::min({c[0], c[1], c[2]});
-  const int hi = std::max({c[0], c[1], c[2]});
-  if (hi - lo > 0.35 * hi + 8) return k;
   const Eigen::Vector3d color(c[0], c[1], c[2]);
+  if (intensity(color) >= dark_limit) return k;  // most samples: the carpet is brighter
+  const Eigen::Vector3d rgb = lut_.colorSpace() == ColorSpace::kYuv ? yuvToRgb(color) : color;
+  if (rgb.maxCoeff() - rgb.minCoeff() > 0.35 * rgb.maxCoeff() + 8) return k;  // saturated
   if (k == kGreen && shadedCarpet(color)) return k;
   // Far from the carpet: beyond zeta times its own spread (green's sigma when that is smaller).
   const double sigma = carpet_spread_ > 0 ? std::min(green.sigma(), carpet_spread_) : green.sigma();
@@ -687,12 +692,16 @@ bool ActTrainer::carpetHue(const Eigen::Vector3d& c) const {
   return t * grey_distance > tolerance && (d - t * hue_axis_).norm() <= tolerance;
 }
 
+double ActTrainer::intensity(const Eigen::Vector3d& c) const {
+  return lut_.colorSpace() == ColorSpace::kYuv ? 3.0 * c[0] : c.sum();
+}
+
 double ActTrainer::darkLimit() const {
   // 80% of the carpet's intensity in the light before the first change, as a position between the
   // own chassis and the carpet (which a change of gain, brightness and contrast keeps): the paper's
   // darkening lifts black, and at a fraction of green's intensity alone no robot trained black
   // after it (tuning scenes 10, 70, 73).
-  const double green = clusters_[kGreen].mean().sum();
+  const double green = intensity(clusters_[kGreen].mean());
   if (!(dark_position_ >= 0) || green - chassis_intensity_ < kMinAnchorSpan) return kDarkFraction * green;
   return chassis_intensity_ + dark_position_ * (green - chassis_intensity_);
 }
@@ -969,11 +978,11 @@ void ActTrainer::measureChassis(const ImageView& image) {
     uint8_t c[3];
     image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
     chassis_samples_.emplace_back(c[0], c[1], c[2]);
-    values.push_back(c[0] + c[1] + c[2]);
+    values.push_back(intensity(Eigen::Vector3d(c[0], c[1], c[2])));
   }
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
   chassis_intensity_ = values[values.size() / 2];
-  const double green = clusters_[kGreen].mean().sum();
+  const double green = intensity(clusters_[kGreen].mean());
   if (!dark_frozen_ && clusters_[kGreen].trained() && green - chassis_intensity_ >= kMinAnchorSpan) {
     dark_position_ = (kDarkFraction * green - chassis_intensity_) / (green - chassis_intensity_);
   }

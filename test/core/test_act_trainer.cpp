@@ -1000,6 +1000,8 @@ TEST_F(ActTrainerTest, TheCarpetInAShadowStaysCarpetBesideDarkRobots) {
   // shadow's carpet is darker than the robots' grey and far from the lit carpet's mean; it is the
   // carpet's color at a lower light (its hue), which no robot is: it stays green, the robots black.
   // Without measureCarpetShade the shadow trained black (green recall 0.82, black precision 0.35).
+  // In YUV the rule measured "dark" by Y + U + V and "unsaturated" on the YUV channels, so no robot
+  // trained black by it (black recall 0.31-0.84 here).
   auto frame = paintFlatFrame(model, pose, 1.0, 1);
   const cv::Vec3b chassis = colorOf(frame.rgb, pose, kBlack);
   const auto lift = [](uint8_t c) { return static_cast<uint8_t>(std::min(255, c + 13)); };
@@ -1016,16 +1018,24 @@ TEST_F(ActTrainerTest, TheCarpetInAShadowStaysCarpetBesideDarkRobots) {
     --column;
   }
   ASSERT_LT(shaded, green_pixels / 4);
-  for (uint32_t seed = 1; seed <= 3; ++seed) {
-    ActParams p;
-    p.seed = seed;
-    ActTrainer trainer(cal, p);
-    trainer.bootstrap(view(frame.rgb), pose, 20);
-    for (int i = 0; i < 20; ++i) trainer.cycle(view(frame.rgb), pose);
-    EXPECT_EQ(trainer.lut().classOf(robot[0], robot[1], robot[2]), kBlack) << "seed " << seed;
-    const ClassificationMetrics m = evaluate(trainer, frame, cal);
-    EXPECT_GT(m.recall(kGreen), 0.95) << "seed " << seed;
-    EXPECT_GT(m.recall(kBlack), 0.9) << "seed " << seed;
-    EXPECT_GT(m.precision(kBlack), 0.9) << "seed " << seed;
+  for (const PixelFormat format : {PixelFormat::kRgb8, PixelFormat::kUyvy}) {
+    const cv::Mat image = format == PixelFormat::kUyvy ? rgbToUyvy(frame.rgb) : frame.rgb;
+    for (uint32_t seed = 1; seed <= 3; ++seed) {
+      SCOPED_TRACE(std::string(encodingName(format)) + " seed " + std::to_string(seed));
+      ActParams p;
+      p.seed = seed;
+      ActTrainer trainer(cal, p);
+      trainer.bootstrap(ImageView::fromMat(image, format), pose, 20);
+      for (int i = 0; i < 20; ++i) trainer.cycle(ImageView::fromMat(image, format), pose);
+      cv::Mat labels;
+      Segmenter(cal.camera).classify(trainer.lut(), ImageView::fromMat(image, format), labels);
+      ClassificationMetrics m;
+      m.add(labels, frame.labels);
+      EXPECT_GT(m.recall(kGreen), 0.95);
+      EXPECT_GT(m.recall(kBlack), 0.9);
+      // The false black pixels are the hall in the shadow, as dark as the robots (370-800 in RGB);
+      // yuv422's chroma, shared by two pixels, blends more of its edges (1,100-2,400).
+      EXPECT_GT(m.precision(kBlack), format == PixelFormat::kUyvy ? 0.85 : 0.9);
+    }
   }
 }

@@ -285,6 +285,9 @@ class ActTrainer {
   void keepLightState();
   // robots_train_black's intensity below which a color is dark, in this cycle's light.
   double darkLimit() const;
+  // The intensity darkLimit() is measured in: the sum of the channels in RGB, 3 Y in YUV (where the
+  // sum would add U + V, about 256 for every grey: the own chassis as bright as the carpet).
+  double intensity(const Eigen::Vector3d& c) const;
   // The ball stage (ActParams::ball_training), after 2.3; needs sector_safe_range_ of the pose.
   void trainBall(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
 
@@ -342,7 +345,7 @@ class ActTrainer {
   std::vector<Eigen::Vector3f> chassis_samples_;  // the own chassis only: an anchor of the light model
   std::array<std::vector<Eigen::Vector3f>, kNumClasses> anchor_samples_;  // scratch of a denser look
   std::vector<uint32_t> chassis_pixels_;  // every n-th pixel of the own chassis, about 192
-  double chassis_intensity_ = 0;          // this cycle's median over them (sum of the channels)
+  double chassis_intensity_ = 0;          // this cycle's median over them (intensity())
   std::vector<double> chassis_intensities_;
   // darkLimit's position between the chassis (0) and the carpet (1), taken until the first change
   // of light; -1 unset.
