@@ -455,9 +455,6 @@ Eigen::Matrix3d meanMetric(ColorSpace space) {
   return a;
 }
 
-// How far a color lies from grey: the largest minus the smallest channel in RGB, |U - 128| +
-// |V - 128| in YUV. A change of gain, brightness, contrast or white balance scales it for every
-// color alike, about.
 // BT.601 full range, as core::rgbToUyvy: in YUV a dark grey's channels ((41, 128, 128)) are far
 // apart, and robots_train_black's "unsaturated" is a property of its RGB color.
 Eigen::Vector3d yuvToRgb(const Eigen::Vector3d& yuv) {
@@ -465,6 +462,9 @@ Eigen::Vector3d yuvToRgb(const Eigen::Vector3d& yuv) {
   return {yuv[0] + 1.402 * v, yuv[0] - 0.344136 * u - 0.714136 * v, yuv[0] + 1.772 * u};
 }
 
+// How far a color lies from grey: the largest minus the smallest channel in RGB, |U - 128| +
+// |V - 128| in YUV. A change of gain, brightness, contrast or white balance scales it for every
+// color alike, about.
 double chroma(const Eigen::Vector3f& c, ColorSpace space) {
   if (space == ColorSpace::kYuv) return std::abs(c[1] - 128.f) + std::abs(c[2] - 128.f);
   return c.maxCoeff() - c.minCoeff();
@@ -650,27 +650,37 @@ void ActTrainer::measureCarpetShade() {
   // absolute deviation; the spread across the line does not grow with the shadow at all.
   carpet_shaded_ = false;
   if (!carpetMeasurable() || !clusters_[kGreen].trained()) return;
-  const Eigen::Vector3f pivot = LightModel::pivot(lut_.colorSpace()).cast<float>();
-  hue_axis_ = (clusters_[kGreen].mean() - pivot.cast<double>()).normalized();
-  const Eigen::Vector3f axis = hue_axis_.cast<float>();
-  auto median = [this](size_t rank) {
-    const auto at = carpet_values_.begin() + static_cast<long>(rank);
-    std::nth_element(carpet_values_.begin(), at, carpet_values_.end());
+  const ColorSpace space = lut_.colorSpace();
+  shade_pivot_ = LightModel::pivot(space);
+  hue_axis_ = (clusters_[kGreen].mean() - shade_pivot_).normalized();
+  const Eigen::Vector3f pivot = shade_pivot_.cast<float>(), axis = hue_axis_.cast<float>();
+  auto median = [](std::vector<float>& values, size_t rank) {
+    const auto at = values.begin() + static_cast<long>(rank);
+    std::nth_element(values.begin(), at, values.end());
     return static_cast<double>(*at);
   };
   const size_t n = carpet_samples_.size();
   carpet_values_.clear();
+  shade_along_.clear();
   for (const Eigen::Vector3f& c : carpet_samples_) {
     const Eigen::Vector3f d = c - pivot;
-    carpet_values_.push_back((d - d.dot(axis) * axis).norm());
+    const float t = d.dot(axis);
+    carpet_values_.push_back((d - t * axis).norm());
+    shade_along_.push_back(t);
   }
-  carpet_hue_spread_ = std::max(median(n * 3 / 4), params_.sigma_min);
-  carpet_values_.clear();
-  for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back((c - pivot).dot(axis));
-  const double middle = median(n / 2);
+  shade_tolerance_ = kShadedCarpetHueSpreads * std::max(median(carpet_values_, n * 3 / 4), params_.sigma_min);
+  // Towards the pivot the line nears the greys (a robot's colors): a point of it lies farther from
+  // them than the tolerance only beyond shade_above_ along it, or a grey would pass for the carpet.
+  const double grey_distance = space == ColorSpace::kYuv
+                                   ? hue_axis_.tail<2>().norm()
+                                   : (hue_axis_ - Eigen::Vector3d::Constant(hue_axis_.mean())).norm();
+  shade_above_ = shade_tolerance_ / grey_distance;
+  carpet_values_ = shade_along_;
+  const double middle = median(carpet_values_, n / 2);
   for (float& t : carpet_values_) t = std::abs(t - static_cast<float>(middle));
   constexpr double kNormalSigmaOverMedianDeviation = 1.4826;
-  const double spread_along = std::max(kNormalSigmaOverMedianDeviation * median(n / 2), params_.sigma_min);
+  const double spread_along =
+      std::max(kNormalSigmaOverMedianDeviation * median(carpet_values_, n / 2), params_.sigma_min);
   shade_below_ = middle - params_.zeta * spread_along;
   size_t shaded = 0;
   for (const Eigen::Vector3f& c : carpet_samples_) shaded += carpetHue(c.cast<double>());
@@ -680,16 +690,9 @@ void ActTrainer::measureCarpetShade() {
 bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const { return carpet_shaded_ && carpetHue(c); }
 
 bool ActTrainer::carpetHue(const Eigen::Vector3d& c) const {
-  const Eigen::Vector3d d = c - LightModel::pivot(lut_.colorSpace());
+  const Eigen::Vector3d d = c - shade_pivot_;
   const double t = d.dot(hue_axis_);
-  if (t >= shade_below_) return false;
-  // Towards the pivot the line nears the greys (a robot's colors): its point at t must lie farther
-  // from them than the tolerance, or a grey would pass for the carpet's hue.
-  const double tolerance = kShadedCarpetHueSpreads * carpet_hue_spread_;
-  const double grey_distance = lut_.colorSpace() == ColorSpace::kYuv
-                                   ? hue_axis_.tail<2>().norm()
-                                   : (hue_axis_ - Eigen::Vector3d::Constant(hue_axis_.mean())).norm();
-  return t * grey_distance > tolerance && (d - t * hue_axis_).norm() <= tolerance;
+  return t < shade_below_ && t > shade_above_ && (d - t * hue_axis_).norm() <= shade_tolerance_;
 }
 
 double ActTrainer::intensity(const Eigen::Vector3d& c) const {
