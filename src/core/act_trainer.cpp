@@ -668,6 +668,14 @@ void ActTrainer::measureCarpetShade() {
     carpet_values_.push_back((d - t * axis).norm());
     shade_along_.push_back(t);
   }
+  shade_median_scratch_ = shade_along_;
+  const double middle = median(shade_median_scratch_, n / 2);
+  // Most cycles: too few samples lie below the median by even zeta times the least spread
+  // (sigma_min) for a shadow; the measures that follow would not open the gate.
+  const float loosest_below = static_cast<float>(middle - params_.zeta * params_.sigma_min) + 0.01f;
+  const size_t below = static_cast<size_t>(
+      std::count_if(shade_along_.begin(), shade_along_.end(), [&](float t) { return t < loosest_below; }));
+  if (below <= kShadedCarpetShare * n) return;
   shade_tolerance_ = kShadedCarpetHueSpreads * std::max(median(carpet_values_, n * 3 / 4), params_.sigma_min);
   // Towards the pivot the line nears the greys (a robot's colors): a point of it lies farther from
   // them than the tolerance only beyond shade_above_ along it, or a grey would pass for the carpet.
@@ -676,7 +684,6 @@ void ActTrainer::measureCarpetShade() {
                                    : (hue_axis_ - Eigen::Vector3d::Constant(hue_axis_.mean())).norm();
   shade_above_ = shade_tolerance_ / grey_distance;
   carpet_values_ = shade_along_;
-  const double middle = median(carpet_values_, n / 2);
   for (float& t : carpet_values_) t = std::abs(t - static_cast<float>(middle));
   constexpr double kNormalSigmaOverMedianDeviation = 1.4826;
   const double spread_along =

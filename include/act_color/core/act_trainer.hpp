@@ -366,7 +366,7 @@ class ActTrainer {
   double shade_above_ = 0;
   double shade_below_ = 0;
   bool carpet_shaded_ = false;
-  std::vector<float> shade_along_;
+  std::vector<float> shade_along_, shade_median_scratch_;
   double goal_min_chroma_ = 0;  // goalColor's least chroma, of this cycle's carpet (measureCarpetColor)
   LightModel light_;
   std::vector<uint8_t> warped_;
