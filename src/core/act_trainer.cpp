@@ -133,6 +133,14 @@ struct StridedPixels {
   int du_, dv_;
 };
 
+// The value of the given rank (0: the smallest) among `values`, whose order it changes.
+template <class T>
+T valueOfRank(std::vector<T>& values, size_t rank) {
+  const auto at = values.begin() + static_cast<long>(rank);
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
+}
+
 }  // namespace
 
 void ActParams::validate() const {
@@ -616,10 +624,9 @@ void ActTrainer::measureCarpetSpread() {
   carpet_values_.clear();
   const Eigen::Vector3f mean = clusters_[kGreen].mean().cast<float>();
   for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back((c - mean).norm());
-  const auto upper_quartile = carpet_values_.begin() + static_cast<long>(carpet_values_.size() * 3 / 4);
-  std::nth_element(carpet_values_.begin(), upper_quartile, carpet_values_.end());
+  const double upper_quartile = valueOfRank(carpet_values_, carpet_values_.size() * 3 / 4);
   constexpr double kRmsOverUpperQuartileDistance = 0.854;
-  carpet_spread_ = std::max(kRmsOverUpperQuartileDistance * *upper_quartile, params_.sigma_min);
+  carpet_spread_ = std::max(kRmsOverUpperQuartileDistance * upper_quartile, params_.sigma_min);
 }
 
 void ActTrainer::measureCarpetColor() {
@@ -633,9 +640,7 @@ void ActTrainer::measureCarpetColor() {
   for (int ch = 0; ch < 3; ++ch) {
     carpet_values_.clear();
     for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back(c[ch]);
-    const auto middle = carpet_values_.begin() + static_cast<long>(carpet_values_.size() / 2);
-    std::nth_element(carpet_values_.begin(), middle, carpet_values_.end());
-    median[ch] = *middle;
+    median[ch] = valueOfRank(carpet_values_, carpet_values_.size() / 2);
   }
   goal_min_chroma_ = kGoalMinChromaOfCarpet * chroma(median, lut_.colorSpace());
 }
@@ -651,32 +656,27 @@ void ActTrainer::measureCarpetShade() {
   carpet_shaded_ = false;
   if (!carpetMeasurable() || !clusters_[kGreen].trained()) return;
   const ColorSpace space = lut_.colorSpace();
-  shade_pivot_ = LightModel::pivot(space);
-  hue_axis_ = (clusters_[kGreen].mean() - shade_pivot_).normalized();
-  const Eigen::Vector3f pivot = shade_pivot_.cast<float>(), axis = hue_axis_.cast<float>();
-  auto median = [](std::vector<float>& values, size_t rank) {
-    const auto at = values.begin() + static_cast<long>(rank);
-    std::nth_element(values.begin(), at, values.end());
-    return static_cast<double>(*at);
-  };
+  const Eigen::Vector3d pivot = LightModel::pivot(space);
+  hue_axis_ = (clusters_[kGreen].mean() - pivot).normalized();
+  const Eigen::Vector3f pivot_f = pivot.cast<float>(), axis = hue_axis_.cast<float>();
   const size_t n = carpet_samples_.size();
-  carpet_values_.clear();
   shade_along_.clear();
-  for (const Eigen::Vector3f& c : carpet_samples_) {
-    const Eigen::Vector3f d = c - pivot;
-    const float t = d.dot(axis);
-    carpet_values_.push_back((d - t * axis).norm());
-    shade_along_.push_back(t);
-  }
-  shade_median_scratch_ = shade_along_;
-  const double middle = median(shade_median_scratch_, n / 2);
+  for (const Eigen::Vector3f& c : carpet_samples_) shade_along_.push_back((c - pivot_f).dot(axis));
+  carpet_values_ = shade_along_;
+  const double middle = valueOfRank(carpet_values_, n / 2);
   // Most cycles: too few samples lie below the median by even zeta times the least spread
   // (sigma_min) for a shadow; the measures that follow would not open the gate.
   const float loosest_below = static_cast<float>(middle - params_.zeta * params_.sigma_min) + 0.01f;
   const size_t below = static_cast<size_t>(
       std::count_if(shade_along_.begin(), shade_along_.end(), [&](float t) { return t < loosest_below; }));
   if (below <= kShadedCarpetShare * n) return;
-  shade_tolerance_ = kShadedCarpetHueSpreads * std::max(median(carpet_values_, n * 3 / 4), params_.sigma_min);
+  carpet_values_.clear();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3f d = carpet_samples_[i] - pivot_f;
+    carpet_values_.push_back((d - shade_along_[i] * axis).norm());
+  }
+  shade_tolerance_ =
+      kShadedCarpetHueSpreads * std::max<double>(valueOfRank(carpet_values_, n * 3 / 4), params_.sigma_min);
   // Towards the pivot the line nears the greys (a robot's colors): a point of it lies farther from
   // them than the tolerance only beyond shade_above_ along it, or a grey would pass for the carpet.
   const double grey_distance = space == ColorSpace::kYuv
@@ -687,7 +687,7 @@ void ActTrainer::measureCarpetShade() {
   for (float& t : carpet_values_) t = std::abs(t - static_cast<float>(middle));
   constexpr double kNormalSigmaOverMedianDeviation = 1.4826;
   const double spread_along =
-      std::max(kNormalSigmaOverMedianDeviation * median(carpet_values_, n / 2), params_.sigma_min);
+      std::max(kNormalSigmaOverMedianDeviation * valueOfRank(carpet_values_, n / 2), params_.sigma_min);
   shade_below_ = middle - params_.zeta * spread_along;
   size_t shaded = 0;
   for (const Eigen::Vector3f& c : carpet_samples_) shaded += carpetHue(c.cast<double>());
@@ -697,7 +697,7 @@ void ActTrainer::measureCarpetShade() {
 bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const { return carpet_shaded_ && carpetHue(c); }
 
 bool ActTrainer::carpetHue(const Eigen::Vector3d& c) const {
-  const Eigen::Vector3d d = c - shade_pivot_;
+  const Eigen::Vector3d d = c - LightModel::pivot(lut_.colorSpace());
   const double t = d.dot(hue_axis_);
   return t < shade_below_ && t > shade_above_ && (d - t * hue_axis_).norm() <= shade_tolerance_;
 }
@@ -990,8 +990,7 @@ void ActTrainer::measureChassis(const ImageView& image) {
     chassis_samples_.emplace_back(c[0], c[1], c[2]);
     values.push_back(intensity(Eigen::Vector3d(c[0], c[1], c[2])));
   }
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  chassis_intensity_ = values[values.size() / 2];
+  chassis_intensity_ = valueOfRank(values, values.size() / 2);
   const double green = intensity(clusters_[kGreen].mean());
   if (!dark_frozen_ && clusters_[kGreen].trained() && green - chassis_intensity_ >= kMinAnchorSpan) {
     dark_position_ = (kDarkFraction * green - chassis_intensity_) / (green - chassis_intensity_);

@@ -355,18 +355,17 @@ class ActTrainer {
   // scratch of its measurements (the samples' distances, one channel of their colors).
   double carpet_spread_ = -1;
   std::vector<float> carpet_values_;
-  // measureCarpetShade: the carpet's hue (the line from shade_pivot_ along the unit vector
+  // measureCarpetShade: the carpet's hue (the line from LightModel::pivot along the unit vector
   // hue_axis_), the distance from it within which a color has that hue (kShadedCarpetHueSpreads
   // times the upper quartile of the carpet samples' distances from it), the positions along it
   // between which such a color is in a shadow, whether more than kShadedCarpetShare of the carpet
   // samples are, and the scratch of their positions along it.
-  Eigen::Vector3d shade_pivot_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d hue_axis_ = Eigen::Vector3d::Zero();
   double shade_tolerance_ = 0;
   double shade_above_ = 0;
   double shade_below_ = 0;
   bool carpet_shaded_ = false;
-  std::vector<float> shade_along_, shade_median_scratch_;
+  std::vector<float> shade_along_;
   double goal_min_chroma_ = 0;  // goalColor's least chroma, of this cycle's carpet (measureCarpetColor)
   LightModel light_;
   std::vector<uint8_t> warped_;
