@@ -1195,6 +1195,11 @@ constexpr size_t kBallAddsPerCycle = 1024;
 
 }  // namespace
 
+uint32_t ActTrainer::labelBall(const CycleStats& stats, cv::Mat& labels) const {
+  if (!stats.ball.seen) return 0;
+  return labelBallImage(model_.camera(), 0.5 * params_.ball_diameter_m, stats.ball.x_m, stats.ball.y_m, labels);
+}
+
 void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transform, CycleStats& stats) {
   if (!clusters_[kGreen].trained()) return;
   // The carpet as its cluster includes it (2.3's zeta sigma, the intensity weighed as in the

@@ -59,7 +59,58 @@ bool BallGeometry::expected(double d, Image* out) const {
   out->radial_px = r_hi - r_lo;
   out->tangential_px = 2.0 * b * r_c;
   out->area_px = M_PI / 4.0 * out->radial_px * out->tangential_px;
+  out->centre_offset_px = 0.5 * (r_lo + r_hi) - r_c;
   return true;
+}
+
+bool BallGeometry::imageEllipse(double x_m, double y_m, Ellipse* out) const {
+  const double d = std::hypot(x_m, y_m);
+  Image im;
+  if (!std::isfinite(d) || !expected(d, &im)) return false;
+  const double e_c = -std::atan2(camera_.viewpointHeight() - radius_m_, d);
+  double u = 0, v = 0;
+  if (!camera_.projectDirection(std::atan2(y_m, x_m), e_c, &u, &v)) return false;
+  const CameraCalibration& cal = camera_.calibration();
+  const double r = std::hypot(u - cal.center_u, v - cal.center_v);
+  if (!(r > 0)) return false;
+  out->axis_u = (u - cal.center_u) / r;
+  out->axis_v = (v - cal.center_v) / r;
+  out->u = u + im.centre_offset_px * out->axis_u;
+  out->v = v + im.centre_offset_px * out->axis_v;
+  out->half_radial_px = 0.5 * im.radial_px;
+  out->half_tangential_px = 0.5 * im.tangential_px;
+  return true;
+}
+
+uint32_t labelBallImage(const OmniCameraModel& camera, double radius_m, double x_m, double y_m, cv::Mat& labels) {
+  BallGeometry::Ellipse e;
+  if (labels.type() != CV_8UC1 || labels.cols != camera.width() || labels.rows != camera.height() ||
+      !BallGeometry(camera, radius_m).imageEllipse(x_m, y_m, &e) || !(e.half_radial_px > 0) ||
+      !(e.half_tangential_px > 0)) {
+    return 0;
+  }
+  const double reach = std::max(e.half_radial_px, e.half_tangential_px);
+  const int u0 = std::max(0, static_cast<int>(std::floor(e.u - reach)));
+  const int u1 = std::min(labels.cols - 1, static_cast<int>(std::ceil(e.u + reach)));
+  const int v0 = std::max(0, static_cast<int>(std::floor(e.v - reach)));
+  const int v1 = std::min(labels.rows - 1, static_cast<int>(std::ceil(e.v + reach)));
+  const double inv_r2 = 1.0 / (e.half_radial_px * e.half_radial_px);
+  const double inv_t2 = 1.0 / (e.half_tangential_px * e.half_tangential_px);
+  uint32_t labelled = 0;
+  for (int v = v0; v <= v1; ++v) {
+    uint8_t* row = labels.ptr<uint8_t>(v);
+    for (int u = u0; u <= u1; ++u) {
+      const double du = u - e.u, dv = v - e.v;
+      const double along = du * e.axis_u + dv * e.axis_v, across = dv * e.axis_u - du * e.axis_v;
+      if (along * along * inv_r2 + across * across * inv_t2 > 1.0) continue;
+      if (row[u] != kUnknown && row[u] != kWhite) continue;
+      const PixelRegion region = camera.ray(u, v).region;
+      if (region != PixelRegion::kFloor && region != PixelRegion::kAboveHorizon) continue;
+      row[u] = kOrange;
+      ++labelled;
+    }
+  }
+  return labelled;
 }
 
 double BallGeometry::distanceFromRadii(double r_near_px, double r_far_px) const {

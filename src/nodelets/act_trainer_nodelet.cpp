@@ -77,8 +77,9 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   void drain();
   // False: the image waits for its pose (may_wait and the pose may still come).
   bool trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_wait);
+  // `trained`: this image's cycle, when it trained (its ball is labelled in /act/classified).
   void publishOutputs(const core::ImageView& view, const sensor_msgs::ImageConstPtr& msg, bool have_pose,
-                      const core::Pose2D& pose);
+                      const core::Pose2D& pose, const core::CycleStats* trained);
   void onTimeJump(const ros::Time& from, const ros::Time& to);
   // The table as slices of its color cube (core::renderLutSlices), when someone listens.
   void publishTableImage();
@@ -663,7 +664,8 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
   // One table per usable image, stamped with it: "the table trained on frames up to and
   // including t", also when this frame could not train (the segmentation then need not wait).
   if (has_table_ && trainer_->lut().colorSpace() == core::nativeColorSpace(view.format)) {
-    publishOutputs(view, msg, have_pose || startup, initial_pose_ && !have_pose ? *initial_pose_ : pose);
+    publishOutputs(view, msg, have_pose || startup, initial_pose_ && !have_pose ? *initial_pose_ : pose,
+                   outcome == Outcome::kTrained ? &last_stats_ : nullptr);
     latency_ms = (ros::Time::now() - msg->header.stamp).toSec() * 1000.0;
   }
   record(outcome, outcome == Outcome::kNoPose ? 0.0 : cycle_ms, latency_ms);
@@ -671,7 +673,7 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
 }
 
 void ActTrainerNodelet::publishOutputs(const core::ImageView& view, const sensor_msgs::ImageConstPtr& msg,
-                                       bool have_pose, const core::Pose2D& pose) {
+                                       bool have_pose, const core::Pose2D& pose, const core::CycleStats* trained) {
   const std_msgs::Header& header = msg->header;
   ++publishable_;
   const bool every = (publishable_ - 1) % static_cast<uint64_t>(publish_lut_every_) == 0;
@@ -693,6 +695,7 @@ void ActTrainerNodelet::publishOutputs(const core::ImageView& view, const sensor
   }
   if (classified_pub_.getNumSubscribers() > 0) {
     segmenter_->classify(trainer_->lut(), view, labels_);
+    if (trained) trainer_->labelBall(*trained, labels_);
     cv_bridge::CvImage out(header, "rgb8");
     core::colorizeLabels(labels_, out.image);
     classified_pub_.publish(out.toImageMsg());

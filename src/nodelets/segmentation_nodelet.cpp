@@ -3,6 +3,7 @@
 // the labels and the features the robot's other modules need.
 #include <cv_bridge/cv_bridge.h>
 #include <diagnostic_updater/diagnostic_updater.h>
+#include <geometry_msgs/PointStamped.h>
 #include <geometry_msgs/Pose2D.h>
 #include <image_transport/image_transport.h>
 #include <nodelet/nodelet.h>
@@ -11,15 +12,18 @@
 
 #include <boost/make_shared.hpp>
 #include <chrono>
+#include <cmath>
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <pluginlib/class_list_macros.hpp>
 #include <string>
 
 #include "act_color/ColorLut.h"
 #include "act_color/SegmentationConfig.h"
 #include "act_color/VisionFeatures.h"
+#include "act_color/core/ball_detector.hpp"
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/feature_extractor.hpp"
 #include "act_color/core/omni_camera_model.hpp"
@@ -36,6 +40,11 @@ class SegmentationNodelet : public nodelet::Nodelet {
   struct PendingImage {
     sensor_msgs::ImageConstPtr image;
     ros::WallTime arrival;
+  };
+  // The trainer's ball sighting of one image (/act/ball: the ball's centre on the carpet, base_link).
+  struct BallSighting {
+    ros::Time stamp;
+    double x_m, y_m;
   };
   // Which table an image was classified with (diagnostics).
   enum class TableUsed { kExact, kOlder, kNewest, kNone, kRejected };
@@ -58,16 +67,19 @@ class SegmentationNodelet : public nodelet::Nodelet {
   void connectCb();
   void onImage(const sensor_msgs::ImageConstPtr& msg);
   void onTable(const act_color::ColorLutConstPtr& msg);
+  void onBall(const geometry_msgs::PointStampedConstPtr& msg);
   void flush();
-  // The classify time in ms.
-  double process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut);
+  // The classify time in ms. `ball`: the trainer's sighting in this image, labelled as the ball's
+  // image (core::labelBallImage).
+  double process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut,
+                 const std::optional<BallSighting>& ball);
   void record(TableUsed table, double classify_ms, double latency_ms);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::Subscriber image_sub_;
-  ros::Subscriber lut_sub_;
+  ros::Subscriber lut_sub_, ball_sub_;
   image_transport::Publisher labels_pub_, labels_color_pub_;
   ros::Publisher features_pub_, debug_pub_;
   ros::WallTimer flush_timer_;
@@ -92,6 +104,8 @@ class SegmentationNodelet : public nodelet::Nodelet {
   size_t table_history_ = 10;
   std::deque<PendingImage> pending_;                // by arrival
   std::deque<act_color::ColorLutConstPtr> tables_;  // shared, never copied; by arrival
+  std::deque<BallSighting> balls_;                  // by arrival, as many as tables
+  double ball_radius_m_ = 0.11;
   // The newest table before time jumped back: used until a table of the new run comes.
   act_color::ColorLutConstPtr fallback_;
   ros_conversions::TimeJumpDetector image_time_;
@@ -134,7 +148,8 @@ bool SegmentationNodelet::configure(std::string* error) {
       !readParam(pnh_, "min_goal_run_px", &c.min_goal_run_px, error) ||
       !readParam(pnh_, "min_obstacle_run_px", &c.min_obstacle_run_px, error) ||
       !readParam(pnh_, "min_ball_pixels", &c.min_ball_pixels, error) ||
-      !readParam(pnh_, "obstacle_merge_m", &c.obstacle_merge_m, error) || !readParam(pnh_, "lazy", &lazy, error) ||
+      !readParam(pnh_, "obstacle_merge_m", &c.obstacle_merge_m, error) ||
+      !readParam(pnh_, "ball_diameter_m", &c.ball_diameter_m, error) || !readParam(pnh_, "lazy", &lazy, error) ||
       !readParam(pnh_, "debug_lut_addresses", &debug, error)) {
     return false;
   }
@@ -201,6 +216,8 @@ bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* 
   fp.min_ball_pixels = c.min_ball_pixels;
   fp.obstacle_merge_m = c.obstacle_merge_m;
   std::ostringstream s;
+  // As the trainer's ball_diameter_m (cfg/ActTrainer.cfg).
+  constexpr double kMinBallDiameterM = 0.05, kMaxBallDiameterM = 1.0;
   if (!(c.queue_size >= 1 && c.queue_size <= 100)) {
     s << "parameter queue_size must be in [1, 100], is " << c.queue_size;
   } else if (!(c.max_wait >= 0.0 && c.max_wait <= 10.0)) {
@@ -209,6 +226,9 @@ bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* 
     s << "parameter table_history must be in [1, 100], is " << c.table_history;
   } else if (!(c.max_pose_age > 0.0 && c.max_pose_age <= 60.0)) {
     s << "parameter max_pose_age must be in (0, 60] s, is " << c.max_pose_age;
+  } else if (!(c.ball_diameter_m >= kMinBallDiameterM && c.ball_diameter_m <= kMaxBallDiameterM)) {
+    s << "parameter ball_diameter_m must be in [" << kMinBallDiameterM << ", " << kMaxBallDiameterM << "] m, is "
+      << c.ball_diameter_m;
   } else {
     try {
       fp.validate();
@@ -225,6 +245,7 @@ bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* 
   queue_size_ = static_cast<size_t>(c.queue_size);
   max_wait_s_ = c.max_wait;
   table_history_ = static_cast<size_t>(c.table_history);
+  ball_radius_m_ = 0.5 * c.ball_diameter_m;
   pose_source_.setMaxAge(c.max_pose_age);
   return true;
 }
@@ -238,10 +259,14 @@ void SegmentationNodelet::connectCb() {
     image_sub_ = it_->subscribe("image", 5, &SegmentationNodelet::onImage, this, hints);
     // ConstPtr: the trainer's very object when in the same manager.
     lut_sub_ = nh_.subscribe("color_lut", 5, &SegmentationNodelet::onTable, this);
+    // Published by the trainer before the table of the same image, so it is here when that comes.
+    ball_sub_ = nh_.subscribe("ball", 5, &SegmentationNodelet::onBall, this);
   } else if (!wanted && image_sub_) {
     image_sub_.shutdown();
     lut_sub_.shutdown();
+    ball_sub_.shutdown();
     pending_.clear();
+    balls_.clear();
   }
 }
 
@@ -264,6 +289,7 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
             before.toSec(), msg->header.stamp.toSec());
         if (!tables_.empty()) fallback_ = tables_.back();
         tables_.clear();
+        balls_.clear();
         pending_.clear();
         window_.clear();
         images_ = labeled_ = exact_table_ = older_table_ = newest_table_ = no_table_ = rejected_ = 0;
@@ -299,6 +325,16 @@ void SegmentationNodelet::onTable(const act_color::ColorLutConstPtr& msg) {
   }
 }
 
+void SegmentationNodelet::onBall(const geometry_msgs::PointStampedConstPtr& msg) {
+  if (!std::isfinite(msg->point.x) || !std::isfinite(msg->point.y)) {
+    ACT_WALL_THROTTLE(5.0, NODELET_ERROR("ball stamped %.3f: not a finite point, ignored", msg->header.stamp.toSec()));
+    return;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  balls_.push_back({msg->header.stamp, msg->point.x, msg->point.y});
+  while (balls_.size() > table_history_) balls_.pop_front();
+}
+
 // Classifies the waiting images whose table is known. Image t takes the table stamped t; once a
 // later table exists, or the image waited ~max_wait or the queue is full (the trainer skipped
 // it or is not running), it takes the latest table stamped before t, else the newest there is
@@ -309,6 +345,7 @@ void SegmentationNodelet::flush() {
     sensor_msgs::ImageConstPtr image;
     act_color::ColorLutConstPtr lut;
     TableUsed used = TableUsed::kNone;
+    std::optional<BallSighting> ball;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (pending_.empty()) return;
@@ -355,9 +392,15 @@ void SegmentationNodelet::flush() {
       if (used != TableUsed::kNewest && used != TableUsed::kNone) fallback_.reset();
       image = front.image;
       pending_.pop_front();
+      // The ball the trainer saw in this very image (with its table).
+      if (used == TableUsed::kExact) {
+        for (const BallSighting& b : balls_) {
+          if (b.stamp == t) ball = b;
+        }
+      }
     }
     try {
-      const double classify_ms = process(image, lut);
+      const double classify_ms = process(image, lut, ball);
       std::lock_guard<std::mutex> lock(mutex_);
       record(used, classify_ms, (ros::Time::now() - image->header.stamp).toSec() * 1000.0);
     } catch (const std::exception& e) {
@@ -376,7 +419,8 @@ void SegmentationNodelet::record(TableUsed table, double classify_ms, double lat
   window_.add({now, table, classify_ms, latency_ms});
 }
 
-double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut) {
+double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut,
+                                    const std::optional<BallSighting>& ball) {
   core::ImageView view;
   std::string error;
   if (!ros_conversions::imageView(*image, &view, &error)) throw std::invalid_argument(error);
@@ -386,6 +430,14 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
   const auto start = std::chrono::steady_clock::now();
   if (lut) {
     segmenter_->classify(ros_conversions::lutView(*lut), view, labels);  // throws for a wrong size or color space
+    if (ball) {
+      double radius_m = 0;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        radius_m = ball_radius_m_;
+      }
+      core::labelBallImage(*camera_, radius_m, ball->x_m, ball->y_m, labels);
+    }
   } else if (image->width != static_cast<uint32_t>(camera_->width()) ||
              image->height != static_cast<uint32_t>(camera_->height())) {
     throw std::invalid_argument("image is " + std::to_string(image->width) + "x" + std::to_string(image->height) +

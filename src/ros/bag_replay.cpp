@@ -267,18 +267,21 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
                "; labelled all unknown, not trained, left out of the metrics");
       labels.setTo(core::kUnknown);
     } else {
+      core::CycleStats stats;  // sees no ball without a cycle
       if (pose && pose->valid) {
         if (!bootstrapped) {
           trainer.bootstrap(view, pose->pose, std::max(0, options.bootstrap_cycles - 1));
           bootstrapped = true;
         }
-        result.pose_contradicted += trainer.cycle(view, pose->pose).pose_contradicted;
+        stats = trainer.cycle(view, pose->pose);
+        result.pose_contradicted += stats.pose_contradicted;
         ++result.trained;
         if (self_mask) self_mask->add(view, pose->pose, trainer.lut());
       } else {
         ++result.without_pose;
       }
       segmenter.classify(trainer.lut(), view, labels);
+      trainer.labelBall(stats, labels);
     }
     out.bag().write("/segmentation/labels", m.getTime(), ros_conversions::labelsToMsg(labels, image->header));
     if (result.images % options.lut_every == 0) {

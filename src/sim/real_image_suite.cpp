@@ -167,6 +167,7 @@ RealImageResult evaluateRealImage(const RealImage& image,
     return fig;
   };
 
+  const core::Segmenter segmenter(cal.camera);
   for (const std::string& variant : realImageVariants()) {
     const ToneCurve curve = variantCurve(variant);
     cv::Mat changed = rgb.clone();
@@ -179,7 +180,7 @@ RealImageResult evaluateRealImage(const RealImage& image,
       core::ActTrainer trainer(cal, params);
       cv::RNG rng(seed);
       std::vector<RealFrameFigures> figures;
-      cv::Mat frame_last, labels_last;
+      cv::Mat frame_last, labels_last, labels;
       for (int f = 0; f < kRealFramesBefore + kRealFramesAfter; ++f) {
         cv::Mat frame = (f < kRealFramesBefore ? rgb : changed).clone();
         cv::Mat noise(frame.size(), CV_16SC3);
@@ -227,11 +228,15 @@ RealImageResult evaluateRealImage(const RealImage& image,
         fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
         fig.hall_as_black = hall.empty() ? 0.0 : static_cast<double>(black) / hall.size();
         if (image.ball) {
+          // The labels as the segmentation gives them: the table's, and the ball's image where the
+          // cycle saw it.
+          segmenter.classify(lut, view, labels);
+          trainer.labelBall(stats, labels);
           size_t inside = 0, inside_ball = 0, predicted = 0, predicted_near = 0;
           for (int i = 0; i < frame.rows * frame.cols; ++i) {
             const int u = i % frame.cols, v = i / frame.cols;
             if (expected.at<uint8_t>(v, u) == core::kNotImaged) continue;
-            const bool ball = classOf(i) == core::kOrange;
+            const bool ball = labels.at<uint8_t>(v, u) == core::kOrange;
             if (image.ball->contains(u, v, -2.0)) {
               ++inside;
               inside_ball += ball;
@@ -248,11 +253,13 @@ RealImageResult evaluateRealImage(const RealImage& image,
         figures.push_back(fig);
         if (first_mode && f == kRealFramesBefore + kRealFramesAfter - 1) {
           frame_last = frame.clone();
-          core::Segmenter(cal.camera).classify(lut, view, labels_last);
+          segmenter.classify(lut, view, labels_last);
+          trainer.labelBall(stats, labels_last);
         }
         if (result.labels_before.empty() && f == kRealFramesBefore - 1) {
           result.frame_before = frame.clone();
-          core::Segmenter(cal.camera).classify(lut, view, result.labels_before);
+          segmenter.classify(lut, view, result.labels_before);
+          trainer.labelBall(stats, result.labels_before);
           if (!image.nubot_table.empty()) {
             size_t imaged = 0, green = 0, black = 0;
             for (int i = 0; i < frame.rows * frame.cols; ++i) {

@@ -51,6 +51,7 @@ BallRun run(const core::Calibration& calibration, const sim::RendererOptions& op
     if (i == 0) trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles - 1);
     const core::CycleStats stats = trainer.cycle(view, pose);
     segmenter.classify(trainer.lut(), view, labels);
+    trainer.labelBall(stats, labels);  // the labels as the segmentation and act_replay give them
     const cv::Mat is_ball = (labels == core::kOrange) & (frame.labels != core::kNotImaged);
     r.frames_with_ball_pixels += cv::countNonZero(is_ball) > 0;
     if (i < kCountFrom || !ball) continue;
@@ -99,6 +100,63 @@ TEST(BallGeometry, ExpectedImageMatchesRenderedBall) {
   }
 }
 
+TEST(BallGeometry, ImageEllipseCoversTheRenderedBall) {
+  // labelBallImage at the ball's true position on labels that know nothing: the ellipse it fills
+  // against the rendered ball, near and far, ahead and to the sides, on two cameras.
+  for (const core::Calibration& calibration : {defaultCalibration(), secondCalibration()}) {
+    const sim::Renderer renderer(calibration);
+    const core::OmniCameraModel& camera = renderer.model().camera();
+    for (const double d : {0.8, 1.5, 3.0, 5.0}) {
+      for (const double bearing : {0.0, 1.2, -2.5}) {
+        sim::Scene scene;
+        scene.lighting = sim_test::cleanLighting();
+        const double x = d * std::cos(bearing), y = d * std::sin(bearing);
+        scene.ball = sim::Ball{x, y, 0.11};  // robot at the origin facing +x
+        const sim::LabeledFrame frame = renderer.render(scene);
+        const cv::Mat truth = frame.labels == core::kOrange;
+        cv::Mat labels(frame.labels.size(), CV_8UC1, cv::Scalar(core::kUnknown));
+        const uint32_t labelled = core::labelBallImage(camera, 0.11, x, y, labels);
+        const cv::Mat ball = labels == core::kOrange;
+        const double hits = cv::countNonZero(ball & truth);
+        EXPECT_EQ(static_cast<int>(labelled), cv::countNonZero(ball));
+        EXPECT_GE(hits, 0.85 * cv::countNonZero(truth)) << d << " m at " << bearing << " rad";
+        EXPECT_GE(hits, 0.8 * labelled) << d << " m at " << bearing << " rad";
+      }
+    }
+  }
+}
+
+TEST(BallGeometry, LabelBallImageKeepsTheOtherClasses) {
+  // Inside the ball's image only what the table left unknown or gave to the lines becomes the
+  // ball's: carpet, robots and goals stay (a ball partly hidden), and so does everything outside it.
+  const core::Calibration calibration = defaultCalibration();
+  const core::OmniCameraModel camera(calibration.camera);
+  const uint8_t kinds[] = {core::kUnknown, core::kGreen, core::kWhite, core::kYellow, core::kBlack};
+  cv::Mat labels(camera.height(), camera.width(), CV_8UC1);
+  for (int v = 0; v < labels.rows; ++v) {
+    for (int u = 0; u < labels.cols; ++u) labels.at<uint8_t>(v, u) = kinds[(u + 2 * v) % 5];
+  }
+  const cv::Mat before = labels.clone();
+  const uint32_t labelled = core::labelBallImage(camera, 0.11, 1.0, 0.4, labels);
+  EXPECT_GT(labelled, 20u);
+  int changed = 0;
+  for (int v = 0; v < labels.rows; ++v) {
+    for (int u = 0; u < labels.cols; ++u) {
+      const uint8_t was = before.at<uint8_t>(v, u), now = labels.at<uint8_t>(v, u);
+      if (was == now) continue;
+      ++changed;
+      EXPECT_EQ(now, core::kOrange);
+      EXPECT_TRUE(was == core::kUnknown || was == core::kWhite) << static_cast<int>(was);
+    }
+  }
+  EXPECT_EQ(changed, static_cast<int>(labelled));
+  // Labels of another size, a ball under the robot's own chassis, no position: nothing.
+  cv::Mat wrong_size(10, 10, CV_8UC1, cv::Scalar(core::kUnknown));
+  EXPECT_EQ(core::labelBallImage(camera, 0.11, 1.0, 0.4, wrong_size), 0u);
+  EXPECT_EQ(core::labelBallImage(camera, 0.11, 0.0, 0.0, labels), 0u);
+  EXPECT_EQ(core::labelBallImage(camera, 0.11, std::nan(""), 0.0, labels), 0u);
+}
+
 TEST(BallTraining, OrangeBallLearnedAndLocated) {
   const BallRun r = run(defaultCalibration(), sim::RendererOptions(), kPose, sim::Ball{0.8, -0.6, 0.11});
   EXPECT_TRUE(r.trained);
@@ -113,9 +171,9 @@ TEST(BallTraining, YellowBallOnAnotherCamera) {
   options.ball.rgb = Eigen::Vector3d(240, 232, 70);  // lemon, unlike the goal's golden yellow
   const BallRun r = run(secondCalibration(), options, kPose, sim::Ball{0.2, 1.4, 0.11});
   EXPECT_TRUE(r.trained);
-  // A regression guard: measured 0.796 here (seeded at frame 18, from 20 frames at one place),
-  // short of issue 13's 0.80, which stays the target (README, "The ball").
-  EXPECT_GE(r.recall, 0.75);
+  // The table alone classified 0.796 of it (seeded at frame 18, from 20 frames at one place): its
+  // highlight and shaded side share the lines' and the hall's colors; the sighting labels them.
+  EXPECT_GE(r.recall, 0.8);
   EXPECT_GE(r.precision, 0.8);
   EXPECT_GE(r.position_ok, r.counted * 9 / 10);
 }

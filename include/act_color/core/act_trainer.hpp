@@ -220,6 +220,10 @@ class ActTrainer {
   bool neighbourOnly(uint32_t cell) const { return neighbour_only_.at(cell) != 0; }
   uint64_t revision() const { return revision_; }
   const ExpectedClassModel& model() const { return model_; }
+  // The ball this cycle saw (`stats.ball`), labelled in the labels of its image: labelBallImage
+  // with this camera and ActParams::ball_diameter_m. Returns the pixels relabelled (0 when the
+  // cycle saw no ball).
+  uint32_t labelBall(const CycleStats& stats, cv::Mat& labels) const;
 
  private:
   ClusterParams clusterParams() const;

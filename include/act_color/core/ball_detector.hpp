@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <vector>
 
 #include "act_color/core/color_lut.hpp"
@@ -25,6 +26,9 @@ class BallGeometry {
     double radial_px = 0;      // extent along the image radius
     double tangential_px = 0;  // extent across it, at the centre's radius
     double area_px = 0;        // of the ellipse with these axes
+    // The middle of the radial extent beyond the image of the centre's direction, along the image
+    // radius (the elevation map is not linear).
+    double centre_offset_px = 0;
   };
   // Expected image of a ball whose centre stands at ground distance d from the robot; false when
   // its centre is not imaged.
@@ -34,10 +38,28 @@ class BallGeometry {
   double distanceFromRadii(double r_near_px, double r_far_px) const;
   double radius() const { return radius_m_; }
 
+  // The ellipse of the expected image of a ball whose centre stands above the floor point (x, y)
+  // of base_link: its centre, the unit vector along the image radius there, and its half extents
+  // along and across it; false when the ball's centre is not imaged.
+  struct Ellipse {
+    double u = 0, v = 0;
+    double axis_u = 1, axis_v = 0;
+    double half_radial_px = 0, half_tangential_px = 0;
+  };
+  bool imageEllipse(double x_m, double y_m, Ellipse* out) const;
+
  private:
   const OmniCameraModel& camera_;
   double radius_m_;
 };
+
+// The ball's image in a label image (issue 13): every imaged pixel inside the expected image of a
+// ball whose centre stands above (x, y) of base_link (BallGeometry::imageEllipse) that the table
+// left unknown or gave to the lines becomes the ball's. A table classifies colors, and a ball's
+// highlight has the clipped lines' colors and its shaded side the hall's: the sighting's shape
+// says what they are. Carpet, robots and goals inside the ellipse keep their class (a ball partly
+// hidden). Returns the pixels relabelled.
+uint32_t labelBallImage(const OmniCameraModel& camera, double radius_m, double x_m, double y_m, cv::Mat& labels);
 
 // A connected blob of pixels on the carpet whose table class is unknown or the ball's, measured
 // as a ball would be.
