@@ -27,6 +27,10 @@ constexpr double kGrowMinRadius = 30.0;
 constexpr size_t kMaxBlobs = 8;
 // A blob whose area or extents exceed a ball's this many times is not a ball alone.
 constexpr double kMaxBallExtent = 2.0;
+// labelBallImage: pixels of the ball's class farther from the ball seen than this many times its
+// image's extent (in that direction) are not the ball. Beyond the image itself: a sighting's
+// position may be a few pixels off (tuning split: 1.5 and 3 gave the same figures).
+constexpr double kOneBallReach = 1.5;
 
 constexpr uint8_t kNoSector = 255;   // BallDetector::sectors_ of a pixel that does not see the floor
 constexpr uint8_t kGridOff = 0;      // not on the carpet, or not a grid point
@@ -89,25 +93,35 @@ uint32_t labelBallImage(const OmniCameraModel& camera, double radius_m, double x
       !(e.half_tangential_px > 0)) {
     return 0;
   }
+  const double inv_r2 = 1.0 / (e.half_radial_px * e.half_radial_px);
+  const double inv_t2 = 1.0 / (e.half_tangential_px * e.half_tangential_px);
+  // (distance from the centre / the ellipse's at that angle)^2
+  auto scaled = [&](int u, int v) {
+    const double du = u - e.u, dv = v - e.v;
+    const double along = du * e.axis_u + dv * e.axis_v, across = dv * e.axis_u - du * e.axis_v;
+    return along * along * inv_r2 + across * across * inv_t2;
+  };
   const double reach = std::max(e.half_radial_px, e.half_tangential_px);
   const int u0 = std::max(0, static_cast<int>(std::floor(e.u - reach)));
   const int u1 = std::min(labels.cols - 1, static_cast<int>(std::ceil(e.u + reach)));
   const int v0 = std::max(0, static_cast<int>(std::floor(e.v - reach)));
   const int v1 = std::min(labels.rows - 1, static_cast<int>(std::ceil(e.v + reach)));
-  const double inv_r2 = 1.0 / (e.half_radial_px * e.half_radial_px);
-  const double inv_t2 = 1.0 / (e.half_tangential_px * e.half_tangential_px);
   uint32_t labelled = 0;
   for (int v = v0; v <= v1; ++v) {
     uint8_t* row = labels.ptr<uint8_t>(v);
     for (int u = u0; u <= u1; ++u) {
-      const double du = u - e.u, dv = v - e.v;
-      const double along = du * e.axis_u + dv * e.axis_v, across = dv * e.axis_u - du * e.axis_v;
-      if (along * along * inv_r2 + across * across * inv_t2 > 1.0) continue;
-      if (row[u] != kUnknown && row[u] != kWhite) continue;
+      if ((row[u] != kUnknown && row[u] != kWhite) || scaled(u, v) > 1.0) continue;
       const PixelRegion region = camera.ray(u, v).region;
       if (region != PixelRegion::kFloor && region != PixelRegion::kAboveHorizon) continue;
       row[u] = kOrange;
       ++labelled;
+    }
+  }
+  // The ball is one: the ball's class away from it is something of its colors.
+  for (int v = 0; v < labels.rows; ++v) {
+    uint8_t* row = labels.ptr<uint8_t>(v);
+    for (int u = 0; u < labels.cols; ++u) {
+      if (row[u] == kOrange && scaled(u, v) > kOneBallReach * kOneBallReach) row[u] = kUnknown;
     }
   }
   return labelled;

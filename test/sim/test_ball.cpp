@@ -128,33 +128,56 @@ TEST(BallGeometry, ImageEllipseCoversTheRenderedBall) {
 
 TEST(BallGeometry, LabelBallImageKeepsTheOtherClasses) {
   // Inside the ball's image only what the table left unknown or gave to the lines becomes the
-  // ball's: carpet, robots and goals stay (a ball partly hidden), and so does everything outside it.
+  // ball's: carpet, robots and goals stay (a ball partly hidden). The ball is one: its class far
+  // from it becomes unknown, near it stays.
   const core::Calibration calibration = defaultCalibration();
   const core::OmniCameraModel camera(calibration.camera);
-  const uint8_t kinds[] = {core::kUnknown, core::kGreen, core::kWhite, core::kYellow, core::kBlack};
+  const uint8_t kinds[] = {core::kUnknown, core::kGreen, core::kWhite, core::kYellow, core::kBlack, core::kOrange};
   cv::Mat labels(camera.height(), camera.width(), CV_8UC1);
   for (int v = 0; v < labels.rows; ++v) {
-    for (int u = 0; u < labels.cols; ++u) labels.at<uint8_t>(v, u) = kinds[(u + 2 * v) % 5];
+    for (int u = 0; u < labels.cols; ++u) labels.at<uint8_t>(v, u) = kinds[(u + 2 * v) % 6];
   }
   const cv::Mat before = labels.clone();
   const uint32_t labelled = core::labelBallImage(camera, 0.11, 1.0, 0.4, labels);
   EXPECT_GT(labelled, 20u);
-  int changed = 0;
+  core::BallGeometry::Ellipse e;
+  ASSERT_TRUE(core::BallGeometry(camera, 0.11).imageEllipse(1.0, 0.4, &e));
+  uint32_t filled = 0, cleared = 0, kept_near = 0;
   for (int v = 0; v < labels.rows; ++v) {
     for (int u = 0; u < labels.cols; ++u) {
       const uint8_t was = before.at<uint8_t>(v, u), now = labels.at<uint8_t>(v, u);
-      if (was == now) continue;
-      ++changed;
-      EXPECT_EQ(now, core::kOrange);
-      EXPECT_TRUE(was == core::kUnknown || was == core::kWhite) << static_cast<int>(was);
+      const double far = std::hypot(u - e.u, v - e.v) / std::max(e.half_radial_px, e.half_tangential_px);
+      if (was == now) {
+        if (now == core::kOrange) {
+          EXPECT_LT(far, 1.6) << u << ", " << v;
+          ++kept_near;
+        }
+        continue;
+      }
+      if (now == core::kOrange) {
+        EXPECT_TRUE(was == core::kUnknown || was == core::kWhite) << static_cast<int>(was);
+        EXPECT_LE(far, 1.0 + 1e-9);
+        ++filled;
+      } else {
+        EXPECT_EQ(was, core::kOrange);
+        EXPECT_EQ(now, core::kUnknown);
+        EXPECT_GT(far, 1.5 * std::min(e.half_radial_px, e.half_tangential_px) /
+                               std::max(e.half_radial_px, e.half_tangential_px) -
+                           1e-9);
+        ++cleared;
+      }
     }
   }
-  EXPECT_EQ(changed, static_cast<int>(labelled));
+  EXPECT_EQ(filled, labelled);
+  EXPECT_GT(kept_near, 5u);
+  EXPECT_GT(cleared, 1000u);
   // Labels of another size, a ball under the robot's own chassis, no position: nothing.
   cv::Mat wrong_size(10, 10, CV_8UC1, cv::Scalar(core::kUnknown));
   EXPECT_EQ(core::labelBallImage(camera, 0.11, 1.0, 0.4, wrong_size), 0u);
+  const cv::Mat unchanged = labels.clone();
   EXPECT_EQ(core::labelBallImage(camera, 0.11, 0.0, 0.0, labels), 0u);
   EXPECT_EQ(core::labelBallImage(camera, 0.11, std::nan(""), 0.0, labels), 0u);
+  EXPECT_EQ(cv::countNonZero(labels != unchanged), 0);
 }
 
 TEST(BallTraining, OrangeBallLearnedAndLocated) {

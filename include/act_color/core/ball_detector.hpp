@@ -53,12 +53,14 @@ class BallGeometry {
   double radius_m_;
 };
 
-// The ball's image in a label image (issue 13): every imaged pixel inside the expected image of a
-// ball whose centre stands above (x, y) of base_link (BallGeometry::imageEllipse) that the table
-// left unknown or gave to the lines becomes the ball's. A table classifies colors, and a ball's
-// highlight has the clipped lines' colors and its shaded side the hall's: the sighting's shape
-// says what they are. Carpet, robots and goals inside the ellipse keep their class (a ball partly
-// hidden). Returns the pixels relabelled.
+// The ball's image in a label image (issue 13), for a ball seen with its centre above (x, y) of
+// base_link: every imaged pixel inside its expected image (BallGeometry::imageEllipse) that the
+// table left unknown or gave to the lines becomes the ball's. A table classifies colors, and a
+// ball's highlight has the clipped lines' colors and its shaded side the hall's: the sighting's
+// shape says what they are. Carpet, robots and goals inside the ellipse keep their class (a ball
+// partly hidden). And the ball is one: pixels of the ball's class farther from it than 1.5 times
+// its image's extent become unknown (a poster or a team marker of its color). Returns the pixels
+// labelled as the ball.
 uint32_t labelBallImage(const OmniCameraModel& camera, double radius_m, double x_m, double y_m, cv::Mat& labels);
 
 // A connected blob of pixels on the carpet whose table class is unknown or the ball's, measured
