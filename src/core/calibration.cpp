@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "act_color/core/file_io.hpp"
 #include "act_color/core/yaml_subset.hpp"
 
 namespace act_color {
@@ -168,8 +169,15 @@ void readSelfMask(CameraCalibration& c, const std::string& source) {
   std::string path = c.self_mask_file;
   const size_t slash = source.rfind('/');
   if (!path.empty() && path[0] != '/' && slash != std::string::npos) path = source.substr(0, slash + 1) + path;
-  const cv::Mat mask = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (mask.empty()) fail(source, "camera.self_mask", "cannot read the image '" + path + "'");
+  // A regular file, not decoded when its header declares another size than the camera's (a FIFO
+  // blocked the loader, a 32000 x 32000 px PNG of 1 MB took 1 GB to decode before it was refused).
+  cv::Mat mask;
+  std::string error;
+  if (!readImageFile(path, cv::IMREAD_GRAYSCALE, kMaxImageFileBytes, std::max(c.width, c.height),
+                     static_cast<int64_t>(c.width) * c.height, &mask, &error)) {
+    fail(source, "camera.self_mask",
+         error + " (the camera is " + std::to_string(c.width) + "x" + std::to_string(c.height) + " px)");
+  }
   if (mask.cols != c.width || mask.rows != c.height) {
     fail(source, "camera.self_mask",
          "'" + path + "' is " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) + " px, the camera is " +
@@ -244,22 +252,8 @@ Calibration parseCalibration(const std::string& yaml_text, const std::string& so
 
 Calibration loadCalibration(const std::string& path) {
   // A regular file of bounded size only: a FIFO or a device would block or never end.
-  std::error_code ec;
-  const std::filesystem::file_status status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) throw CalibrationError(path + ": cannot be read (no such file)");
-  if (!std::filesystem::is_regular_file(status)) throw CalibrationError(path + ": is not a regular file");
-  const uintmax_t size = std::filesystem::file_size(path, ec);
-  const YamlLimits limits;
-  if (ec) throw CalibrationError(path + ": cannot be read");
-  if (size > limits.max_bytes) {
-    throw CalibrationError(path + ": " + std::to_string(size) + " bytes, more than the " +
-                           std::to_string(limits.max_bytes) + " a calibration file may have");
-  }
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw CalibrationError(path + ": cannot be read");
-  std::string text(static_cast<size_t>(size), '\0');
-  file.read(&text[0], static_cast<std::streamsize>(size));
-  text.resize(static_cast<size_t>(file.gcount()));
+  std::string text, error;
+  if (!readRegularFile(path, YamlLimits().max_bytes, &text, &error)) throw CalibrationError(path + ": " + error);
   return parseCalibration(text, path);
 }
 
@@ -315,6 +309,31 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
     const double lowest = map[k - 1].second + std::clamp(t, 0.0, 1.0) * (map[k].second - map[k - 1].second);
     if (!(lowest < 0)) {
       fail(source, "camera.elevation_map", "no imaged pixel looks below the horizon: the camera would see no floor");
+    }
+    // And enough pixels do (a ring of 1e-7 px passed the test above and trained nothing): those
+    // whose centre lies between lo and the radius of the horizon (or hi).
+    double horizon = hi;
+    for (size_t j = 1; j < map.size(); ++j) {
+      if (map[j].second >= 0 && map[j - 1].second < 0) {
+        horizon = map[j - 1].first +
+                  (0 - map[j - 1].second) / (map[j].second - map[j - 1].second) * (map[j].first - map[j - 1].first);
+        break;
+      }
+    }
+    const double top = std::min(hi, horizon);
+    int64_t floor_pixels = 0;
+    for (int v = 0; v < c.height; ++v) {
+      const double dv = v - c.center_v;
+      for (int u = 0; u < c.width; ++u) {
+        const double du = u - c.center_u, r2 = du * du + dv * dv;
+        floor_pixels += r2 >= lo * lo && r2 < top * top;
+      }
+    }
+    const int64_t needed = std::max<int64_t>(16, static_cast<int64_t>(c.width) * c.height / 100);
+    if (floor_pixels < needed) {
+      fail(source, "camera.elevation_map",
+           "images the floor in " + std::to_string(floor_pixels) + " pixels, fewer than " + std::to_string(needed) +
+               " (1% of the image): the camera would see no field");
     }
   }
 

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "act_color/core/field_model.hpp"
+#include "act_color/core/file_io.hpp"
 #include "act_color/core/omni_camera_model.hpp"
 
 namespace act_color {
@@ -1395,12 +1396,13 @@ std::optional<double> xmlNumber(const std::string& text, const std::string& path
   return number;
 }
 
+// NuBot's XML files are a few hundred bytes.
+constexpr size_t kMaxNubotXmlBytes = size_t{1} << 20;
+
 std::string readText(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw CalibrationError(path + ": cannot be read");
-  std::stringstream s;
-  s << file.rdbuf();
-  return s.str();
+  std::string text, error;
+  if (!readRegularFile(path, kMaxNubotXmlBytes, &text, &error)) throw CalibrationError(error);
+  return text;
 }
 
 double requireNumber(const std::string& text, const std::string& path, const std::string& key) {
@@ -1412,8 +1414,9 @@ double requireNumber(const std::string& text, const std::string& path, const std
 }  // namespace
 
 std::vector<cv::Point2f> readNubotWhites(const std::string& path) {
-  std::ifstream file(path);
-  if (!file) throw std::runtime_error(path + ": cannot be read");
+  std::string text, error;
+  if (!readRegularFile(path, kMaxImageFileBytes, &text, &error)) throw std::runtime_error(error);
+  std::istringstream file(text);
   std::vector<cv::Point2f> out;
   double x, y;
   while (file >> x >> y) out.emplace_back(static_cast<float>(x), static_cast<float>(y));

@@ -10,8 +10,12 @@
 #include <filesystem>
 #include <vector>
 
+#include "act_color/core/file_io.hpp"
+
 namespace act_color {
 namespace ros_conversions {
+
+namespace core = act_color::core;
 namespace {
 
 namespace fs = std::filesystem;
@@ -19,43 +23,6 @@ constexpr size_t kMagicBytes = sizeof(kLutFileMagic) - 1;
 constexpr size_t kClusterBytes = 1 + 3 * 4 + 4 + 4 + 4;  // ClassCluster: class_id, mean[3], sigma, samples, lut_cells
 constexpr uint32_t kMaxFrameIdBytes = 1024;
 constexpr uint32_t kMaxClusters = 64;
-
-// Reads a whole regular file of at most `limit` bytes; never blocks on a FIFO or device.
-bool readRegularFile(const std::string& path, size_t limit, std::vector<uint8_t>* data, std::string* error) {
-  if (path.find('\0') != std::string::npos) {
-    *error = "the path contains a NUL byte";
-    return false;
-  }
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
-    *error = "cannot open '" + path + "': " + std::strerror(errno);
-    return false;
-  }
-  struct stat st {};
-  bool ok = ::fstat(fd, &st) == 0;
-  if (!ok || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    *error = "'" + path + "' is not a regular file";
-    return false;
-  }
-  if (static_cast<uint64_t>(st.st_size) > limit) {
-    ::close(fd);
-    *error = "'" + path + "' is " + std::to_string(st.st_size) + " bytes, more than a color table file can be (" +
-             std::to_string(limit) + ")";
-    return false;
-  }
-  data->resize(static_cast<size_t>(st.st_size));
-  size_t done = 0;
-  while (done < data->size()) {
-    const ssize_t n = ::read(fd, data->data() + done, data->size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    done += static_cast<size_t>(n);
-  }
-  ::close(fd);
-  data->resize(done);
-  return true;
-}
 
 // True when the regular file at `path` begins with the magic line (reads only that).
 bool startsAsTableFile(const std::string& path) {
@@ -126,34 +93,13 @@ bool saveLutFile(const act_color::ColorLut& msg, const std::string& path, std::s
   ::ros::serialization::OStream stream(buffer.data() + kMagicBytes, size);
   ::ros::serialization::serialize(stream, msg);
 
-  std::string tmp = path + ".XXXXXX";
-  const int fd = ::mkstemp(&tmp[0]);
-  if (fd < 0) {
-    *error = "cannot write beside '" + path + "': " + std::strerror(errno);
-    return false;
-  }
-  size_t done = 0;
-  while (done < buffer.size()) {
-    const ssize_t n = ::write(fd, buffer.data() + done, buffer.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    done += static_cast<size_t>(n);
-  }
-  const bool written = done == buffer.size() && ::fchmod(fd, 0644) == 0 && ::fsync(fd) == 0;
-  const int saved_errno = errno;
-  ::close(fd);
-  if (!written || ::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int e = written ? errno : saved_errno;
-    ::unlink(tmp.c_str());
-    *error = "cannot write '" + path + "': " + std::strerror(e);
-    return false;
-  }
-  return true;
+  return core::writeFileAtomically(path, buffer.data(), buffer.size(), error);
 }
 
 bool loadLutFile(const std::string& path, act_color::ColorLut* msg, std::string* error) {
-  std::vector<uint8_t> data;
-  if (!readRegularFile(path, kMaxLutFileBytes, &data, error)) return false;
+  std::string bytes;
+  if (!core::readRegularFile(path, kMaxLutFileBytes, &bytes, error, "a color table file")) return false;
+  std::vector<uint8_t> data(bytes.begin(), bytes.end());
   if (data.size() < kMagicBytes || std::memcmp(data.data(), kLutFileMagic, kMagicBytes) != 0) {
     *error = "'" + path + "' is not a color table file (saved by ~save_lut)";
     return false;

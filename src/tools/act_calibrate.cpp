@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/file_io.hpp"
 #include "act_color/core/mirror_calibrator.hpp"
 #include "act_color/sim/calibrator_check.hpp"
 #include "cli_numbers.hpp"
@@ -174,8 +175,12 @@ int main(int argc, char** argv) {
     }
     cv::Mat image;
     if (!image_path.empty()) {
-      image = cv::imread(image_path, cv::IMREAD_COLOR);  // BGR, as OpenCV writes PNGs
-      if (image.empty()) throw std::runtime_error(image_path + ": cannot be read as an image");
+      // BGR, as OpenCV writes PNGs; a regular file, its size checked before it is decoded.
+      std::string error;
+      if (!core::readImageFile(image_path, cv::IMREAD_COLOR, core::kMaxImageFileBytes, core::kMaxImageSidePx,
+                               core::kMaxImagePixels, &image, &error)) {
+        throw std::runtime_error(error);
+      }
     }
     core::MirrorCalibrator calibrator(calibration.field, options);
     core::Pose2D pose = options.pose;

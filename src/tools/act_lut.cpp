@@ -13,6 +13,8 @@
 // 0 ball ("yellow represent for football"), 1 black (obstacles), 2 green (field), 3 unknown; their
 // lines are found by brightness along scan lines, not by the table, and there are no goal classes.
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -29,6 +31,7 @@
 
 #include "act_color/ColorLut.h"
 #include "act_color/core/color_lut.hpp"
+#include "act_color/core/file_io.hpp"
 #include "act_color/core/lut_image.hpp"
 #include "act_color/core/types.hpp"
 #include "act_color/ros/conversions.hpp"
@@ -66,6 +69,17 @@ int usage(const std::string& message) {
 struct FileError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// NuBot's table file (to-nubot): written beside and renamed, so that its input or a table of
+// another kind is never truncated on the way; only a regular file is replaced.
+void writeWholeFile(const std::string& output, const std::vector<uint8_t>& bytes) {
+  struct stat st {};
+  if (::lstat(output.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    throw FileError("'" + output + "' exists and is not a regular file: not replaced");
+  }
+  std::string error;
+  if (!core::writeFileAtomically(output, bytes.data(), bytes.size(), &error)) throw FileError(error);
+}
 
 // ---------------------------------------------------------------------------------------------
 // NuBot's table
@@ -292,10 +306,7 @@ int toNubotFile(const std::string& path, const std::string& output) {
       }
     }
   }
-  std::ofstream out(output, std::ios::binary | std::ios::trunc);
-  if (!out) throw FileError("cannot open '" + output + "' for writing");
-  out.write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
-  if (!out.good()) throw FileError("cannot write '" + output + "'");
+  writeWholeFile(output, file);
   std::printf("wrote %s: NuBot %s, 64^3 bytes\n", output.c_str(), nubotLayout(space));
   if (bits != kNubotBits) {
     std::printf("  resampled from %d bits per channel (%s)\n", bits,
@@ -310,9 +321,9 @@ int toNubotFile(const std::string& path, const std::string& output) {
 }
 
 std::vector<uint8_t> readNubotFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileError("cannot open '" + path + "'");
-  std::vector<uint8_t> file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string bytes, error;
+  if (!core::readRegularFile(path, kNubotCells, &bytes, &error, "a NuBot table (64^3)")) throw FileError(error);
+  const std::vector<uint8_t> file(bytes.begin(), bytes.end());
   if (file.size() != kNubotCells) {
     throw FileError("'" + path + "' has " + std::to_string(file.size()) + " bytes, a NuBot table has " +
                     std::to_string(kNubotCells) + " (64^3)");

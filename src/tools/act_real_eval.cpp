@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/file_io.hpp"
 #include "act_color/core/mirror_calibrator.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/sim/real_image_suite.hpp"
@@ -154,9 +155,11 @@ int main(int argc, char** argv) {
     act_color::sim::RealImage image;
     const size_t slash = folder.find_last_of('/');
     image.name = (slash == std::string::npos ? folder : folder.substr(slash + 1)) + "/" + image_name;
-    image.bgr = cv::imread(folder + "/" + image_name, cv::IMREAD_COLOR);
-    if (image.bgr.empty()) {
-      std::cerr << "act_real_eval: " << folder << "/" << image_name << ": cannot be read\n";
+    std::string error;
+    if (!act_color::core::readImageFile(folder + "/" + image_name, cv::IMREAD_COLOR,
+                                        act_color::core::kMaxImageFileBytes, act_color::core::kMaxImageSidePx,
+                                        act_color::core::kMaxImagePixels, &image.bgr, &error)) {
+      std::cerr << "act_real_eval: " << error << "\n";
       return 1;
     }
     try {

@@ -266,6 +266,12 @@ TEST(Calibration, AnImageTooLargeOrAMapThatImagesNothingIsRefused) {
   std::string far = replaced(contractText(), "[42.0, -1.45]", "[1000.0, -1.45]");
   far = replaced(far, "[286.0, 0.20]", "[2000.0, 0.20]");
   EXPECT_NE(errorOf(far).find("images no pixel"), std::string::npos) << errorOf(far);
+  // A map beginning 1e-7 px inside the mirror's rim: a ring no pixel centre lies in.
+  std::string sliver = replaced(contractText(), "[42.0, -1.45]", "[285.9999999, -1.2]");
+  sliver = replaced(sliver, "[286.0, 0.20]", "[400.0, -0.1]");
+  EXPECT_NE(errorOf(sliver).find("camera.elevation_map: images the floor in 0 pixels, fewer than 3364"),
+            std::string::npos)
+      << errorOf(sliver);
 }
 
 TEST(Calibration, OnlyRegularFilesAreRead) {

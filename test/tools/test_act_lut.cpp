@@ -1,6 +1,7 @@
 // act_lut as a user runs it: tables built here and saved as ~save_lut saves them, inspected, drawn,
 // converted to NuBot's 64^3 tables and back; NuBot's real tables imported; bad files refused.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -562,6 +563,27 @@ TEST(ActLut, BadFilesExitOneWithAMessage) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   r = run("to-nubot " + good + " --output /nonexistent_dir/CTableBGR.dat");
   EXPECT_EQ(r.exit_code, 1) << r.output;
+  // A device or a FIFO is neither read (/dev/zero grew without end, a FIFO blocked) nor written.
+  r = run("from-nubot /dev/zero --color-space rgb --output " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("'/dev/zero' is not a regular file"), std::string::npos) << r.output;
+  const std::string fifo = tempDir() + "/fifo_CTableBGR.dat";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  r = run("from-nubot " + fifo + " --output " + out);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("is not a regular file"), std::string::npos) << r.output;
+  r = run("to-nubot " + good + " --output " + fifo);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.output.find("exists and is not a regular file: not replaced"), std::string::npos) << r.output;
+  EXPECT_FALSE(exists(out));
+  // A NuBot table converted onto itself is replaced whole, not truncated on the way.
+  const std::string nubot = tempDir() + "/self_CTableBGR.dat";
+  writeBytes(nubot, std::vector<uint8_t>(kCells, 2));
+  const std::string ours = tempDir() + "/self.lut";
+  ASSERT_EQ(run("from-nubot " + nubot + " --output " + ours).exit_code, 0);
+  r = run("to-nubot " + ours + " --output " + nubot);
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(run("from-nubot " + nubot + " --output " + ours).exit_code, 0);
 }
 
 TEST(ActLut, WrongArgumentsExitTwoWithTheUsage) {
