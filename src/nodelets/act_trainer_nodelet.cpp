@@ -268,7 +268,11 @@ bool ActTrainerNodelet::configure(std::string* error) {
   }
 
   std::vector<double> initial_pose;
-  if (pnh_.getParam("initial_pose", initial_pose) && !initial_pose.empty()) {
+  if (pnh_.hasParam("initial_pose") && !pnh_.getParam("initial_pose", initial_pose)) {
+    *error = "~initial_pose must be a list [x_m, y_m, theta_rad] of numbers, or [] for none";
+    return false;
+  }
+  if (!initial_pose.empty()) {
     core::Pose2D p;
     if (initial_pose.size() != 3 || !(p = core::Pose2D{initial_pose[0], initial_pose[1], initial_pose[2]}).isFinite()) {
       *error = "~initial_pose must be [x_m, y_m, theta_rad] with finite values";
@@ -401,6 +405,10 @@ bool ActTrainerNodelet::configure(std::string* error) {
 void ActTrainerNodelet::loadCalibration(const core::ActParams& params, const std::string& load_path) {
   std::string calibration_path;
   const core::Calibration calibration = ros_conversions::loadCalibrationParam(pnh_, &pose_source_, &calibration_path);
+  std::string off_field;
+  if (initial_pose_ && !pose_source_.plausible(*initial_pose_, &off_field)) {
+    throw std::runtime_error("~initial_pose: " + off_field);
+  }
   // The camera model of every pixel: the part that grows with the image.
   auto trainer = std::make_unique<core::ActTrainer>(calibration, params);
   auto segmenter = std::make_unique<core::Segmenter>(calibration.camera);
@@ -601,10 +609,6 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
     record(Outcome::kRejected, 0.0, -1.0);
     return true;
   }
-  if (has_table_ && trainer_->lut().colorSpace() != core::nativeColorSpace(view.format)) {
-    NODELET_ERROR("the color table is %s but the camera sends %s: the table starts afresh",
-                  trainer_->lut().colorSpace() == core::ColorSpace::kYuv ? "YUV" : "RGB", msg->encoding.c_str());
-  }
   camera_format_ = view.format;
 
   core::Pose2D pose;
@@ -612,6 +616,12 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
   const bool have_pose = pose_source_.lookup(msg->header.stamp, &pose, &why);
   const bool startup = !has_table_ && (initial_pose_ || (bootstrap_at_first_pose_ && have_pose));
   if (!have_pose && !startup && may_wait && pose_source_.mayStillCome(msg->header.stamp)) return false;
+  // Said when it happens (the cycle below starts the table afresh), not while the image waits.
+  if (has_table_ && have_pose && trainer_->lut().colorSpace() != core::nativeColorSpace(view.format)) {
+    ACT_WALL_THROTTLE(5.0, NODELET_ERROR("the color table is %s but the camera sends %s: the table starts afresh",
+                                         trainer_->lut().colorSpace() == core::ColorSpace::kYuv ? "YUV" : "RGB",
+                                         msg->encoding.c_str()));
+  }
   if (params_changed_) {
     trainer_->setParams(params_);
     params_changed_ = false;

@@ -8,11 +8,15 @@
 #include <nodelet/NodeletLoad.h>
 #include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 
 #include <chrono>
 #include <cstdio>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "act_color/FilePath.h"
 
@@ -92,6 +96,42 @@ TEST(LoadPath, FailedCalibrationIsReported) {
   EXPECT_NE(answer.find("the nodelet is not configured: bad calibration"), std::string::npos) << answer;
   EXPECT_NE(answer.find("/nonexistent/calibration.yaml"), std::string::npos) << answer;
   EXPECT_TRUE(unload("/broken/trainer"));
+}
+
+// ~initial_pose mistyped or off the field: refused with a message naming it (it was ignored, or
+// trained the start-up table at a pose 1000 km away), the nodelet stays loaded, the manager goes on.
+TEST(LoadPath, AWrongInitialPoseIsRefused) {
+  ASSERT_TRUE(ros::service::waitForService("/load_manager/load_nodelet", ros::Duration(30.0)));
+  ros::NodeHandle nh;
+  std::mutex mutex;
+  std::vector<std::string> errors;
+  ros::Subscriber log_sub = nh.subscribe<rosgraph_msgs::Log>("/rosout", 100, [&](const rosgraph_msgs::LogConstPtr& m) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (m->level >= rosgraph_msgs::Log::ERROR) errors.push_back(m->name + ": " + m->msg);
+  });
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  // Connected to the manager's /rosout (and the test's own) before anything is said.
+  const auto connecting = std::chrono::steady_clock::now();
+  while (log_sub.getNumPublishers() < 2 && since(connecting) < 10.0) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  for (const auto& [name, expected] : std::vector<std::pair<std::string, std::string>>{
+           {"/typo/trainer", "not started: ~initial_pose must be a list [x_m, y_m, theta_rad] of numbers"},
+           {"/far/trainer", "not started: ~initial_pose: pose (1e+06, 0) m is off the field"}}) {
+    ASSERT_TRUE(load(name, "act_color/act_trainer"));
+    const auto start = std::chrono::steady_clock::now();
+    bool said = false;
+    while (!said && since(start) < 30.0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      std::lock_guard<std::mutex> lock(mutex);
+      for (const std::string& e : errors) said = said || e.find(expected) != std::string::npos;
+    }
+    EXPECT_TRUE(said) << name << ": no error '" << expected << "' in /rosout";
+    EXPECT_TRUE(unload(name));
+  }
+  ASSERT_TRUE(load("/small/segmentation", "act_color/segmentation"));
+  EXPECT_TRUE(unload("/small/segmentation"));
 }
 
 // Nodelets loaded and unloaded again and again, at once or after their calibration loaded, with a

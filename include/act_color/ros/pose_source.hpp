@@ -48,6 +48,8 @@ class PoseSource {
   uint64_t rejected() const;
   // A message for the last rejected pose; empty when none.
   std::string lastRejection() const;
+  // False with a reason for a pose off the field (the calibration's, with its margin).
+  bool plausible(const core::Pose2D& pose, std::string* why) const;
 
  private:
   void onPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg);
@@ -56,8 +58,6 @@ class PoseSource {
   std::string name_;
   double max_age_s_ = 1.0;
   double half_x_m_ = 1e9, half_y_m_ = 1e9;
-  // False with a reason for a pose off the field.
-  bool plausible(const core::Pose2D& pose, std::string* why) const;
   std::string field_frame_ = "field";
   std::string base_frame_ = "base_link";
   ros::Subscriber sub_;
