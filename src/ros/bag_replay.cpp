@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -196,13 +197,37 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
   countTopic(in, options.truth_topic, "sensor_msgs/Image", path);
   countTopic(in, options.events_topic, "std_msgs/String", path);
 
-  // Poses by stamp (small), truth and events indexed by stamp and read when needed.
+  auto warn = [&log](size_t seen_before, const char* kind, const std::string& message) {
+    constexpr size_t kShown = 5;
+    if (seen_before < kShown) log << "act_replay: warning: " << message << "\n";
+    if (seen_before + 1 == kShown) log << "act_replay: further " << kind << " are only counted\n";
+  };
+
+  // Poses by stamp (small), truth and events indexed by stamp and read when needed. A pose that is
+  // no robot's on this field (NaN, tilted, off the field and its margin, as the nodelets check) is
+  // not used, and said why.
+  const core::FieldCalibration& field = calibration.field;
+  const double half_x = 0.5 * field.length_m + field.margin_m + 1.0,
+               half_y = 0.5 * field.width_m + field.margin_m + 1.0;
   std::vector<StampedPose> poses;
+  size_t unusable_poses = 0;
   for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery(options.pose_topic))) {
     const auto msg = instantiate<geometry_msgs::PoseWithCovarianceStamped>(m, path);
     StampedPose p{msg->header.stamp, false, {}};
     std::string error;
     p.valid = ros_conversions::pose2D(msg->pose.pose, &p.pose, &error);
+    if (p.valid && !(std::abs(p.pose.x_m) <= half_x && std::abs(p.pose.y_m) <= half_y)) {
+      p.valid = false;
+      std::ostringstream s;
+      s << "pose (" << p.pose.x_m << ", " << p.pose.y_m << ") m is off the field (|x| <= " << half_x
+        << ", |y| <= " << half_y << " m with the margin)";
+      error = s.str();
+    }
+    if (!p.valid) {
+      std::ostringstream at;
+      at << options.pose_topic << " at " << p.stamp << ": " << error << "; not used";
+      warn(unusable_poses++, "unusable poses", at.str());
+    }
     poses.push_back(p);
   }
   std::stable_sort(poses.begin(), poses.end(),
@@ -231,12 +256,6 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
   size_t next_event = 0;
   auto last_progress = std::chrono::steady_clock::now();
   // The first few of each kind in full, then only counted (the summary has the totals).
-  auto warn = [&log](size_t seen_before, const char* kind, const std::string& message) {
-    constexpr size_t kShown = 5;
-    if (seen_before < kShown) log << "act_replay: warning: " << message << "\n";
-    if (seen_before + 1 == kShown) log << "act_replay: further " << kind << " are only counted\n";
-  };
-
   for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery(options.image_topic))) {
     *frame = result.images;
     const auto image = instantiate<sensor_msgs::Image>(m, path);

@@ -119,8 +119,8 @@ bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::vector<co
 bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* error) {
   const auto& p = pose.position;
   const auto& q = pose.orientation;
-  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z) ||
-      !std::isfinite(q.w)) {
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(q.x) || !std::isfinite(q.y) ||
+      !std::isfinite(q.z) || !std::isfinite(q.w)) {
     *error = "pose has NaN or infinite values";
     return false;
   }

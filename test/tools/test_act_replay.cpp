@@ -1,5 +1,6 @@
 // act_replay end to end, without a master: scenario bags written by act_make_scenarios, replayed
 // through runReplay() and the act_replay executable.
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -339,6 +340,38 @@ TEST(ActReplay, ShortTruthIsLeftOutOfTheMetrics) {
   EXPECT_NE(text.find("no frame with truth on /omni/labels_truth: no metrics"), std::string::npos) << text;
   EXPECT_EQ(text.find("recall"), std::string::npos) << text;
   EXPECT_EQ(text.find("nan"), std::string::npos) << text;
+}
+
+// Poses that are no robot's on this field (1000 km off, z NaN): not used, each said why (they
+// trained the table at that pose before, without a word).
+TEST(ActReplay, PosesOffTheFieldAreNotUsed) {
+  const std::string src = scenarioBag("static_darkening"), in = tempDir() + "/far_poses.bag";
+  {
+    rosbag::Bag input(src);
+    std::vector<ros::Time> image_times;
+    for (const auto& m : rosbag::View(input, rosbag::TopicQuery("/omni/image_raw"))) image_times.push_back(m.getTime());
+    ASSERT_GE(image_times.size(), 6u);
+    rosbag::Bag output(in, rosbag::bagmode::Write);
+    size_t pose_index = 0;
+    for (const auto& m : rosbag::View(input, ros::TIME_MIN, image_times[5])) {
+      if (m.getTopic() != "/localization/pose") {
+        output.write(m.getTopic(), m.getTime(), m);
+        continue;
+      }
+      auto pose = m.instantiate<geometry_msgs::PoseWithCovarianceStamped>();
+      if (pose_index >= 2) pose->pose.pose.position.x = 1e6;           // from the third pose on: far off
+      if (pose_index == 1) pose->pose.pose.position.z = std::nan("");  // the second: no height
+      ++pose_index;
+      output.write(m.getTopic(), m.getTime(), pose);
+    }
+  }
+  std::ostringstream log;
+  const auto result = runReplay(options(in, tempDir() + "/far_poses.out.bag"), log);
+  EXPECT_EQ(result.images, 6u);
+  EXPECT_EQ(result.trained, 1u) << log.str();  // the first pose only
+  EXPECT_NE(log.str().find("pose (1e+06, "), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("m is off the field"), std::string::npos) << log.str();
+  EXPECT_NE(log.str().find("pose has NaN or infinite values; not used"), std::string::npos) << log.str();
 }
 
 // Images whose step is too small or whose data is short: labelled all unknown, not trained, left
