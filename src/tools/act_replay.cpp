@@ -3,9 +3,12 @@
 #include <ros/time.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <string>
 
 #include "act_color/core/calibration.hpp"
@@ -53,8 +56,29 @@ int main(int argc, char** argv) {
         if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
         return argv[++i];
       };
-      auto number = [&]() { return std::stod(value()); };
-      auto integer = [&]() { return std::stoi(value()); };
+      // Read whole and checked: "abc", "1e400" or "-1" where a count goes are refused by name.
+      auto number = [&]() {
+        const std::string text = value();
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !std::isfinite(v)) {
+          throw std::invalid_argument(arg + ": '" + text + "' is not a finite number");
+        }
+        return v;
+      };
+      auto integer = [&](long long lo = std::numeric_limits<int>::min(),
+                         long long hi = std::numeric_limits<int>::max()) {
+        const std::string text = value();
+        char* end = nullptr;
+        errno = 0;
+        const long long v = std::strtoll(text.c_str(), &end, 10);
+        if (text.empty() || *end != '\0' || errno == ERANGE || v < lo || v > hi) {
+          throw std::invalid_argument(arg + ": '" + text + "' is not an integer in [" + std::to_string(lo) + ", " +
+                                      std::to_string(hi) + "]");
+        }
+        return v;
+      };
+      constexpr long long kManyFrames = 1000000000;
       if (arg == "--help" || arg == "-h") {
         printUsage(std::cout);
         return 0;
@@ -73,7 +97,7 @@ int main(int argc, char** argv) {
       } else if (arg == "--events-topic") {
         options.events_topic = value();
       } else if (arg == "--seed") {
-        p.seed = static_cast<uint32_t>(std::stoul(value()));
+        p.seed = static_cast<uint32_t>(integer(0, std::numeric_limits<uint32_t>::max()));
       } else if (arg == "--zeta") {
         p.zeta = number();
       } else if (arg == "--xi") {
@@ -83,19 +107,19 @@ int main(int argc, char** argv) {
       } else if (arg == "--sigma-min") {
         p.sigma_min = number();
       } else if (arg == "--cluster-stride") {
-        p.cluster_stride = integer();
+        p.cluster_stride = static_cast<int>(integer());
       } else if (arg == "--add-stride") {
-        p.add_stride = integer();
+        p.add_stride = static_cast<int>(integer());
       } else if (arg == "--remove-stride") {
-        p.remove_stride = integer();
+        p.remove_stride = static_cast<int>(integer());
       } else if (arg == "--lut-bits") {
-        p.lut_bits = integer();
+        p.lut_bits = static_cast<int>(integer());
       } else if (arg == "--paper") {
         p.switchOffExtensions();
       } else if (arg == "--neighbourhood-cells") {
-        p.add_neighbourhood_cells = integer();
+        p.add_neighbourhood_cells = static_cast<int>(integer());
       } else if (arg == "--removal-protect-cycles") {
-        p.removal_protect_cycles = integer();
+        p.removal_protect_cycles = static_cast<int>(integer());
       } else if (arg == "--evidence-removal-ratio") {
         p.evidence_removal_ratio = number();
       } else if (arg == "--set") {
@@ -103,17 +127,17 @@ int main(int argc, char** argv) {
       } else if (arg == "--no-nearest-mean") {
         p.nearest_mean = false;
       } else if (arg == "--bootstrap-cycles") {
-        options.bootstrap_cycles = integer();
+        options.bootstrap_cycles = static_cast<int>(integer(0, 100000));
       } else if (arg == "--lut-every") {
-        options.lut_every = static_cast<size_t>(std::stoul(value()));
+        options.lut_every = static_cast<size_t>(integer(1, kManyFrames));
       } else if (arg == "--adapt-frames") {
-        options.adapt_frames = static_cast<size_t>(std::stoul(value()));
+        options.adapt_frames = static_cast<size_t>(integer(0, kManyFrames));
       } else if (arg == "--csv") {
         options.csv_path = value();
       } else if (arg == "--png") {
         options.png_dir = value();
       } else if (arg == "--png-every") {
-        options.png_every = std::max<size_t>(1, std::stoul(value()));
+        options.png_every = static_cast<size_t>(integer(1, kManyFrames));
       } else if (arg == "--learn-self-mask") {
         options.self_mask_png = value();
       } else if (arg == "--brief") {

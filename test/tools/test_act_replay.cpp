@@ -229,6 +229,19 @@ TEST(ActReplay, ClearErrorsForUnusableInput) {
   // The executable: usage errors exit 2, unusable input 1.
   const std::string tool = std::string(ACT_TOOLS_DIR) + "/act_replay";
   EXPECT_EQ(WEXITSTATUS(std::system((tool + " --bag " + in + " 2> /dev/null").c_str())), 2);
+  // Numbers read whole and in range (they wrapped or were clamped silently: --seed -1, --png-every 0).
+  const std::string required = " --bag " + in + " --calibration " + kCalibration + " --output " + tempDir() + "/x.bag ";
+  for (const auto& [option, said] : std::vector<std::pair<std::string, std::string>>{
+           {"--seed -1", "--seed: '-1' is not an integer in [0, 4294967295]"},
+           {"--png-every 0", "--png-every: '0' is not an integer in [1, 1000000000]"},
+           {"--lut-every -1", "--lut-every: '-1' is not an integer"},
+           {"--bootstrap-cycles -5", "--bootstrap-cycles: '-5' is not an integer in [0, 100000]"},
+           {"--zeta abc", "--zeta: 'abc' is not a finite number"},
+           {"--cluster-stride 99999999999", "--cluster-stride: '99999999999' is not an integer"}}) {
+    std::string text;
+    EXPECT_EQ(run(tool + required + option, &text), 2) << option;
+    EXPECT_NE(text.find(said), std::string::npos) << option << ": " << text;
+  }
   EXPECT_EQ(WEXITSTATUS(std::system((tool + " --bag " + junk + " --calibration " + kCalibration + " --output " +
                                      tempDir() + "/x.bag 2> /dev/null")
                                         .c_str())),
