@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace act_color {
@@ -117,11 +118,14 @@ uint32_t labelBallImage(const OmniCameraModel& camera, double radius_m, double x
       ++labelled;
     }
   }
-  // The ball is one: the ball's class away from it is something of its colors.
+  // The ball is one: the ball's class away from it is something of its colors. (memchr: the
+  // image has few such pixels, and a byte-wise loop over all of it cost 0.2 ms at 580x580.)
+  const size_t cols = static_cast<size_t>(labels.cols);
   for (int v = 0; v < labels.rows; ++v) {
     uint8_t* row = labels.ptr<uint8_t>(v);
-    for (int u = 0; u < labels.cols; ++u) {
-      if (row[u] == kOrange && scaled(u, v) > kOneBallReach * kOneBallReach) row[u] = kUnknown;
+    for (auto* p = static_cast<uint8_t*>(std::memchr(row, kOrange, cols)); p;
+         p = static_cast<uint8_t*>(std::memchr(p + 1, kOrange, cols - static_cast<size_t>(p + 1 - row)))) {
+      if (scaled(static_cast<int>(p - row), v) > kOneBallReach * kOneBallReach) *p = kUnknown;
     }
   }
   return labelled;

@@ -82,27 +82,29 @@ ImageView view(const Frame& f) { return ImageView::fromMat(f.rgb, PixelFormat::k
 // The ACT trainer nodelet's per-image work (src/nodelets/act_trainer_nodelet.cpp, processImage):
 // a view of the message, checkImage, one cycle, the table copied into a shared message.
 act_color::ColorLutConstPtr trainerCallback(ActTrainer& trainer, const sensor_msgs::ImageConstPtr& msg,
-                                            const Pose2D& pose) {
+                                            const Pose2D& pose, core::CycleStats::Ball* ball) {
   ImageView v;
   std::string error;
   if (!conv::imageView(*msg, &v, &error)) throw std::runtime_error(error);
   trainer.checkImage(v);
-  trainer.cycle(v, pose);
+  *ball = trainer.cycle(v, pose).ball;  // published on /act/ball when seen
   return conv::toMsg(trainer, msg->header);
 }
 
 // The segmentation nodelet's per-image work (src/nodelets/segmentation_nodelet.cpp, process): a
 // view of the message, the labels written straight into a new mono8 message with the shared
-// table (no copy of it).
-sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter,
+// table (no copy of it), the ball the trainer saw labelled as its image.
+sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter, const core::OmniCameraModel& camera,
                                                 const sensor_msgs::ImageConstPtr& image,
-                                                const act_color::ColorLutConstPtr& lut) {
+                                                const act_color::ColorLutConstPtr& lut,
+                                                const core::CycleStats::Ball& ball) {
   ImageView v;
   std::string error;
   if (!conv::imageView(*image, &v, &error)) throw std::runtime_error(error);
   cv::Mat labels;
   sensor_msgs::ImagePtr labels_msg = conv::newLabelsMsg(*image, &labels);
   segmenter.classify(conv::lutView(*lut), v, labels);
+  if (ball.seen) core::labelBallImage(camera, 0.11, ball.x_m, ball.y_m, labels);
   return labels_msg;
 }
 
@@ -142,7 +144,7 @@ class RosPipeline {
 
  private:
   void onTrainerImage(const sensor_msgs::ImageConstPtr& msg) {
-    act_color::ColorLutConstPtr lut = trainerCallback(*trainer_, msg, pose_);
+    act_color::ColorLutConstPtr lut = trainerCallback(*trainer_, msg, pose_, &ball_);
     published_lut_ = lut.get();
     lut_pub_.publish(lut);
   }
@@ -157,7 +159,7 @@ class RosPipeline {
   }
   void flush() {
     if (!pending_ || !table_ || table_->header.stamp != pending_->header.stamp) return;
-    labels_pub_.publish(segmentationCallback(*segmenter_, pending_, table_));
+    labels_pub_.publish(segmentationCallback(*segmenter_, trainer_->model().camera(), pending_, table_, ball_));
     pending_.reset();
   }
   void onLabels(const sensor_msgs::ImageConstPtr&) { ++labels_; }
@@ -169,6 +171,7 @@ class RosPipeline {
   ros::Publisher image_pub_, lut_pub_, labels_pub_;
   std::vector<ros::Subscriber> subs_;
   Pose2D pose_;
+  core::CycleStats::Ball ball_;  // the trainer's sighting in the image being segmented
   sensor_msgs::ImageConstPtr pending_;
   act_color::ColorLutConstPtr table_;
   const act_color::ColorLut* published_lut_ = nullptr;
@@ -235,6 +238,21 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
   cv::Mat labels, labels_b;
   add("classify", [&] { segmenter.classify(trainer.lut(), view(frames[i++ % frames.size()]), labels); });
   add("classify_unmasked", [&] { unmasked.classify(trainer.lut(), view(frames[i++ % frames.size()]), labels); });
+  // The segmentation's labelling of a ball sighting (core::labelBallImage) on classified labels
+  // (with a copy of the labels, some 3 us at 580x580, so that every call labels the same).
+  {
+    ActTrainer seeing = trainer;
+    core::CycleStats::Ball seen;
+    for (size_t k = 0; k < frames.size() && !seen.seen; ++k) seen = seeing.cycle(view(frames[k]), frames[k].pose).ball;
+    if (seen.seen) {
+      segmenter.classify(trainer.lut(), view(frames[0]), labels);
+      cv::Mat work = labels.clone();
+      add("label_ball", [&] {
+        labels.copyTo(work);
+        core::labelBallImage(trainer.model().camera(), 0.11, seen.x_m, seen.y_m, work);
+      });
+    }
+  }
   core::LutView lv{trainer.lut().data(), trainer.lut().size(), trainer.lut().bitsPerChannel(), core::ColorSpace::kRgb};
   add("classify_lutview_nodelet", [&] { lut_view_segmenter.classify(lv, view(frames[i++ % frames.size()]), labels); });
   add("cmvision_bitmask", [&] { cmvision.classify(frames[i++ % frames.size()].rgb, labels); });
@@ -249,11 +267,16 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
   add("step_labels_to_msg", [&] { conv::labelsToMsg(labels, frames[i++ % frames.size()].msg->header); });
   // Both nodelets' per-frame work.
   ActTrainer path_trainer = trainer;
+  uint64_t balls_seen = 0;
   add("nodelet_path_calls", [&] {
     const Frame& f = frames[i++ % frames.size()];
-    const auto lut = trainerCallback(path_trainer, f.msg, f.pose);
-    segmentationCallback(lut_view_segmenter, f.msg, lut);
+    core::CycleStats::Ball ball;
+    const auto lut = trainerCallback(path_trainer, f.msg, f.pose, &ball);
+    balls_seen += ball.seen;
+    segmentationCallback(lut_view_segmenter, path_trainer.model().camera(), f.msg, lut, ball);
   });
+  // How many of the path's images had a ball sighting (labelled as its image by the segmentation).
+  result.agreement["nodelet_path_ball_sightings"] = static_cast<double>(balls_seen);
   if (ros_master) {
     ActTrainer ros_trainer = trainer;
     RosPipeline pipeline(&ros_trainer, &lut_view_segmenter);
