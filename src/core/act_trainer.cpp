@@ -342,17 +342,32 @@ void ActTrainer::loadTable(const ColorLut& lut) {
   space_known_ = true;
 }
 
-void ActTrainer::restore(const ColorLut& lut, const std::vector<SavedCluster>& clusters, uint64_t revision) {
-  for (const SavedCluster& c : clusters) {
-    const bool finite = c.mean.allFinite() && std::isfinite(c.sigma);
-    if (c.class_id < 1 || c.class_id >= kNumClasses || !finite || !(c.sigma > 0.0) || c.mean.minCoeff() < 0.0 ||
-        c.mean.maxCoeff() > 255.0) {
-      std::ostringstream s;
-      s << "cluster of class " << c.class_id << " (mean " << c.mean.transpose() << ", sigma " << c.sigma
-        << ") is not a cluster of a class 1-" << kNumClasses - 1;
-      throw std::invalid_argument(s.str());
-    }
+std::string ActTrainer::SavedCluster::problem() const {
+  const bool finite = mean.allFinite() && std::isfinite(sigma);
+  if (class_id >= 1 && class_id < kNumClasses && finite && sigma > 0.0 && mean.minCoeff() >= 0.0 &&
+      mean.maxCoeff() <= 255.0) {
+    return "";
   }
+  std::ostringstream s;
+  s << "cluster of class " << class_id << " (mean " << mean.transpose() << ", sigma " << sigma
+    << ") is not a cluster of a class 1-" << kNumClasses - 1;
+  return s.str();
+}
+
+std::string ActTrainer::clustersProblem(const std::vector<SavedCluster>& clusters) {
+  std::array<bool, kNumClasses> given{};
+  for (const SavedCluster& c : clusters) {
+    const std::string problem = c.problem();
+    if (!problem.empty()) return problem;
+    if (given[c.class_id]) return "two clusters of class " + std::to_string(c.class_id);
+    given[c.class_id] = true;
+  }
+  return "";
+}
+
+void ActTrainer::restore(const ColorLut& lut, const std::vector<SavedCluster>& clusters, uint64_t revision) {
+  const std::string problem = clustersProblem(clusters);
+  if (!problem.empty()) throw std::invalid_argument(problem);
   loadTable(lut);
   for (ClassCluster& cluster : clusters_) cluster.reset(255.0);
   const auto counts = lut_.cellCounts();

@@ -113,7 +113,8 @@ bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::vector<co
     saved.sigma = c.sigma;
     clusters->push_back(saved);
   }
-  return true;
+  *error = core::ActTrainer::clustersProblem(*clusters);
+  return error->empty();
 }
 
 bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* error) {

@@ -187,7 +187,9 @@ Table loadTable(const std::string& path) {
   Table t;
   std::string error;
   if (!conv::loadLutFile(path, &t.msg, &error)) throw FileError(error);
-  if (!conv::fromMsg(t.msg, &t.lut, &error)) throw FileError(path + ": " + error);
+  // The clusters checked as ~load_lut checks them (a table whose clusters it refuses is no good).
+  std::vector<core::ActTrainer::SavedCluster> clusters;
+  if (!conv::fromMsg(t.msg, &t.lut, &clusters, &error)) throw FileError(path + ": " + error);
   return t;
 }
 

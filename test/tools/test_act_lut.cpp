@@ -519,12 +519,22 @@ TEST(ActLut, BadFilesExitOneWithAMessage) {
   small.table.assign(10, 0);
   std::string error;
   ASSERT_TRUE(conv::saveLutFile(small, inconsistent, &error)) << error;
+  // Clusters ~load_lut refuses (info showed them and exited 0).
+  const std::string nan_sigma = tempDir() + "/nan_sigma.lut", twice = tempDir() + "/twice.lut";
+  act_color::ColorLutPtr msg = saveTable(boxTable(core::ColorSpace::kRgb), nan_sigma);
+  msg->clusters[0].sigma = std::nanf("");
+  ASSERT_TRUE(conv::saveLutFile(*msg, nan_sigma, &error)) << error;
+  msg = saveTable(boxTable(core::ColorSpace::kRgb), twice);
+  msg->clusters[1].class_id = msg->clusters[0].class_id;
+  ASSERT_TRUE(conv::saveLutFile(*msg, twice, &error)) << error;
 
   const std::vector<std::pair<std::string, std::string>> cases = {
       {truncated, "truncated or corrupt"},
       {magic, "is not a color table file"},
       {missing, "cannot open"},
       {inconsistent, "table has 10 cells, expected 262144"},
+      {nan_sigma, "is not a cluster of a class 1-6"},
+      {twice, "two clusters of class 1"},
   };
   for (const auto& c : cases) {
     const ToolRun info = run("info " + c.first);

@@ -204,7 +204,13 @@ class ActTrainer {
     int class_id = 0;  // 1 .. kNumClasses - 1
     Eigen::Vector3d mean;
     double sigma = 0;
+    // Why this is no cluster of a class (class id, NaN, sigma <= 0, mean outside the channel
+    // range); empty when it is one.
+    std::string problem() const;
   };
+  // The first problem of a saved state's clusters: one's (SavedCluster::problem) or a class given
+  // twice; empty when there is none.
+  static std::string clustersProblem(const std::vector<SavedCluster>& clusters);
   // Installs a saved state: the table, the clusters it was trained with and its revision, so that
   // training goes on where it stopped. A class whose cluster is not given, or that has no cell in
   // the table, starts at eq. 2-3. Throws std::invalid_argument for sizes that differ or a cluster
