@@ -174,7 +174,18 @@ std::string truthMessageProblem(const sensor_msgs::Image& truth, uint32_t width,
            std::to_string(width) + "x" + std::to_string(height);
   }
   const std::string problem = ros_conversions::imageLayoutProblem(truth, 1);
-  return problem.empty() ? problem : "truth " + problem;
+  if (!problem.empty()) return "truth " + problem;
+  // Class ids of the contract only (0-6, 255 not imaged): another value is no truth.
+  for (uint32_t v = 0; v < height; ++v) {
+    const uint8_t* row = truth.data.data() + static_cast<size_t>(v) * truth.step;
+    for (uint32_t u = 0; u < width; ++u) {
+      if (row[u] >= core::kNumClasses && row[u] != core::kNotImaged) {
+        return "truth holds " + std::to_string(row[u]) + " at (" + std::to_string(u) + ", " + std::to_string(v) +
+               "), not a class id (0-6, 255 not imaged)";
+      }
+    }
+  }
+  return "";
 }
 
 namespace {

@@ -285,6 +285,11 @@ TEST(ActReplay, MessageChecksSayWhatIsWrong) {
   EXPECT_EQ(truthMessageProblem(truth, 4, 3), "truth data has 11 bytes, less than step 4 * height 3 = 12");
   truth.data.resize(12);
   EXPECT_EQ(truthMessageProblem(truth, 4, 3), "");
+  truth.data[6] = 255;  // not imaged
+  EXPECT_EQ(truthMessageProblem(truth, 4, 3), "");
+  truth.data[6] = 9;  // no class (it was scored as one)
+  EXPECT_EQ(truthMessageProblem(truth, 4, 3), "truth holds 9 at (2, 1), not a class id (0-6, 255 not imaged)");
+  truth.data[6] = 0;
   EXPECT_EQ(truthMessageProblem(truth, 4, 4), "truth is 4x3, its image 4x4");
   truth.step = 3;
   EXPECT_EQ(truthMessageProblem(truth, 4, 3), "truth step 3 is less than width 4 * 1 bytes per pixel (mono8) = 4");
