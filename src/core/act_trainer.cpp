@@ -12,15 +12,6 @@ namespace act_color {
 namespace core {
 namespace {
 
-void requireRange(const char* name, double value, double lo, double hi, bool lo_open = false) {
-  const bool below = lo_open ? !(value > lo) : !(value >= lo);
-  if (below || !(value <= hi)) {
-    std::ostringstream s;
-    s << "parameter " << name << " must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], is " << value;
-    throw std::invalid_argument(s.str());
-  }
-}
-
 // Weight of the intensity difference in the nearest-mean rule (ActParams::nearest_mean).
 constexpr double kIntensityWeight = 0.1;
 // robots_train_black: dark is below this fraction of the carpet's intensity (ActTrainer::darkLimit);
@@ -144,20 +135,20 @@ T valueOfRank(std::vector<T>& values, size_t rank) {
 }  // namespace
 
 void ActParams::validate() const {
-  requireRange("eta", eta, 0.0, 1000.0);
-  requireRange("zeta", zeta, 0.0, 100.0, true);
-  requireRange("xi", xi, 0.0, 100.0, true);
-  requireRange("sigma_min", sigma_min, 0.0, 255.0);
-  requireRange("cluster_stride", cluster_stride, 1, 1 << 20);
-  requireRange("add_stride", add_stride, 1, 1 << 20);
-  requireRange("remove_stride", remove_stride, 1, 1 << 20);
-  requireRange("lut_bits", lut_bits, 1, 8);
-  requireRange("add_neighbourhood_cells", add_neighbourhood_cells, 0, 3);
-  requireRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
-  requireRange("robot_height_m", robot_height_m, 0.0, 5.0);
-  requireRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
-  requireRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
-  requireRange("ball_diameter_m", ball_diameter_m, 0.05, 1.0);
+  requireParameterRange("eta", eta, 0.0, 1000.0);
+  requireParameterRange("zeta", zeta, 0.0, 100.0, true);
+  requireParameterRange("xi", xi, 0.0, 100.0, true);
+  requireParameterRange("sigma_min", sigma_min, 0.0, 255.0);
+  requireParameterRange("cluster_stride", cluster_stride, 1, 1 << 20);
+  requireParameterRange("add_stride", add_stride, 1, 1 << 20);
+  requireParameterRange("remove_stride", remove_stride, 1, 1 << 20);
+  requireParameterRange("lut_bits", lut_bits, 1, 8);
+  requireParameterRange("add_neighbourhood_cells", add_neighbourhood_cells, 0, 3);
+  requireParameterRange("removal_protect_cycles", removal_protect_cycles, 0, 1000000);
+  requireParameterRange("robot_height_m", robot_height_m, 0.0, 5.0);
+  requireParameterRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
+  requireParameterRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
+  requireParameterRange("ball_diameter_m", ball_diameter_m, 0.05, 1.0);
 }
 
 void ActParams::set(const std::string& name, const std::string& value) {

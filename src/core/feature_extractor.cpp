@@ -150,11 +150,7 @@ std::vector<Feature> extractFeatures(const cv::Mat& labels, const OmniCameraMode
 
 void FeatureParams::validate() const {
   auto require = [](const char* name, double value, double lo, double hi) {
-    if (!(value >= lo && value <= hi)) {
-      std::ostringstream s;
-      s << "parameter " << name << " must be in [" << lo << ", " << hi << "], is " << value;
-      throw std::invalid_argument(s.str());
-    }
+    requireParameterRange(name, value, lo, hi);
   };
   require("scan_lines", scan_lines, 4, 3600);
   require("max_line_run_px", max_line_run_px, 1, 1000);

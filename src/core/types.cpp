@@ -1,5 +1,9 @@
 #include "act_color/core/types.hpp"
 
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
 namespace act_color {
 namespace core {
 
@@ -20,6 +24,15 @@ const std::array<std::array<uint8_t, 3>, kNumClasses>& classPalette() {
       {{255, 120, 0}},    // orange
   }};
   return kPalette;
+}
+
+void requireParameterRange(const char* name, double value, double lo, double hi, bool lo_open) {
+  const bool below = lo_open ? !(value > lo) : !(value >= lo);
+  if (!below && value <= hi) return;
+  std::ostringstream s;
+  s << std::setprecision(10) << "parameter " << name << " must be in " << (lo_open ? "(" : "[") << lo << ", " << hi
+    << "], is " << value;
+  throw std::invalid_argument(s.str());
 }
 
 }  // namespace core

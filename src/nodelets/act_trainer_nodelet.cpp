@@ -509,11 +509,13 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
     return false;
   }
   auto outside = [&](const char* name, double value, double lo, double hi, bool lo_open) {
-    if ((lo_open ? value > lo : value >= lo) && value <= hi) return false;
-    std::ostringstream s;
-    s << "parameter " << name << " must be in " << (lo_open ? "(" : "[") << lo << ", " << hi << "], is " << value;
-    *error = s.str();
-    return true;
+    try {
+      core::requireParameterRange(name, value, lo, hi, lo_open);
+      return false;
+    } catch (const std::invalid_argument& e) {
+      *error = e.what();
+      return true;
+    }
   };
   if (outside("max_pose_age", c.max_pose_age, 0.0, 60.0, true) ||
       outside("tf_timeout", c.tf_timeout, 0.0, 5.0, false) ||

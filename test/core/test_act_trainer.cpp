@@ -95,6 +95,10 @@ TEST_F(ActTrainerTest, ParametersAreValidatedByName) {
   p = ActParams();
   p.lut_bits = 9;
   EXPECT_NE(error(p).find("lut_bits"), std::string::npos);
+  // The value as given and the limits as integers (they read "[1, 1.04858e+06], is 1.04858e+06").
+  p = ActParams();
+  p.cluster_stride = 1048577;
+  EXPECT_EQ(error(p), "parameter cluster_stride must be in [1, 1048576], is 1048577");
   p = ActParams();
   p.eta = -1;
   EXPECT_NE(error(p).find("eta"), std::string::npos);

@@ -36,6 +36,11 @@ struct Pose2D {
   bool isFinite() const { return std::isfinite(x_m) && std::isfinite(y_m) && std::isfinite(theta_rad); }
 };
 
+// Throws std::invalid_argument "parameter NAME must be in [lo, hi], is VALUE" (open at lo with
+// lo_open) unless value lies in the range; NaN never does. The numbers are printed with up to 10
+// significant digits: an integer limit of 1048576 reads as such, not as 1.04858e+06.
+void requireParameterRange(const char* name, double value, double lo, double hi, bool lo_open = false);
+
 // An angle in (-pi, pi].
 inline double wrapAngle(double a) { return std::atan2(std::sin(a), std::cos(a)); }
 
