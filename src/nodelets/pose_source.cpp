@@ -56,7 +56,9 @@ void PoseSource::onPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& 
       msg->header.frame_id != "/" + field_frame_) {
     ++rejected_;
     last_rejection_ = "pose in frame '" + msg->header.frame_id + "' rejected: expected '" + field_frame_ + "'";
-    ACT_WALL_THROTTLE(5.0, ROS_ERROR("%s: %s", name_.c_str(), last_rejection_.c_str()));
+    // Throttled per nodelet (a throttle per call site is one for every nodelet in the manager: the
+    // segmentation's rejection went unsaid behind the trainer's).
+    if (wallThrottle(name_ + " frame", 5.0)) ROS_ERROR("%s: %s", name_.c_str(), last_rejection_.c_str());
     return;
   }
   if (!newest_stamp_.isZero() && msg->header.stamp + ros::Duration(TimeJumpDetector::kJumpBackS) < newest_stamp_) {

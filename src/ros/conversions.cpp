@@ -125,6 +125,12 @@ bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* err
     *error = "pose has NaN or infinite values";
     return false;
   }
+  if (std::abs(p.z) > kMaxHeightM) {
+    std::ostringstream s;
+    s << "pose is " << p.z << " m above the floor, a robot's base_link is not";
+    *error = s.str();
+    return false;
+  }
   const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
   if (std::abs(norm - 1.0) > kMaxQuaternionNormError) {
     std::ostringstream s;

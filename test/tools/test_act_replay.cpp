@@ -20,6 +20,7 @@
 #include "act_color/ColorLut.h"
 #include "act_color/core/calibration.hpp"
 #include "act_color/ros/bag_replay.hpp"
+#include "act_color/ros/conversions.hpp"
 #include "tool_test_util.hpp"
 
 using act_color::ros_layer::ReplayError;
@@ -390,6 +391,27 @@ TEST(ActReplay, PosesOffTheFieldAreNotUsed) {
   EXPECT_NE(log.str().find("pose (1e+06, "), std::string::npos) << log.str();
   EXPECT_NE(log.str().find("m is off the field"), std::string::npos) << log.str();
   EXPECT_NE(log.str().find("pose has NaN or infinite values; not used"), std::string::npos) << log.str();
+}
+
+// What no robot's pose on the floor is (the nodelets and act_replay take none of it).
+TEST(ActReplay, PosesOfNoRobotOnTheFloorAreRefused) {
+  geometry_msgs::Pose pose;
+  pose.position.x = 1.0;
+  pose.orientation.w = 1.0;
+  act_color::core::Pose2D out;
+  std::string error;
+  EXPECT_TRUE(act_color::ros_conversions::pose2D(pose, &out, &error)) << error;
+  pose.position.z = 5000.0;
+  EXPECT_FALSE(act_color::ros_conversions::pose2D(pose, &out, &error));
+  EXPECT_EQ(error, "pose is 5000 m above the floor, a robot's base_link is not");
+  pose.position.z = std::nan("");
+  EXPECT_FALSE(act_color::ros_conversions::pose2D(pose, &out, &error));
+  EXPECT_EQ(error, "pose has NaN or infinite values");
+  pose.position.z = 0.0;
+  pose.orientation.w = std::cos(0.25);  // rolled by 0.5 rad
+  pose.orientation.x = std::sin(0.25);
+  EXPECT_FALSE(act_color::ros_conversions::pose2D(pose, &out, &error));
+  EXPECT_NE(error.find("tilted"), std::string::npos) << error;
 }
 
 // Images whose step is too small or whose data is short: labelled all unknown, not trained, left

@@ -35,10 +35,12 @@ bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* e
 bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::vector<core::ActTrainer::SavedCluster>* clusters,
              std::string* error);
 
-// Pose of base_link in field from a pose message; false with a reason for NaN/inf, a quaternion
-// that is not a unit one (within kMaxQuaternionNormError) or a tilt (roll/pitch) above kMaxTiltRad.
+// Pose of base_link in field from a pose message; false with a reason for NaN/inf, a height off
+// the floor beyond kMaxHeightM, a quaternion that is not a unit one (within
+// kMaxQuaternionNormError) or a tilt (roll/pitch) above kMaxTiltRad.
 constexpr double kMaxQuaternionNormError = 0.01;
 constexpr double kMaxTiltRad = 10.0 * M_PI / 180.0;
+constexpr double kMaxHeightM = 1.0;
 bool pose2D(const geometry_msgs::Pose& pose, core::Pose2D* out, std::string* error);
 
 // mono8 label image message with the given header (copies the labels once).
