@@ -175,8 +175,7 @@ void readSelfMask(CameraCalibration& c, const std::string& source) {
   std::string error;
   if (!readImageFile(path, cv::IMREAD_GRAYSCALE, kMaxImageFileBytes, std::max(c.width, c.height),
                      static_cast<int64_t>(c.width) * c.height, &mask, &error)) {
-    fail(source, "camera.self_mask",
-         error + " (the camera is " + std::to_string(c.width) + "x" + std::to_string(c.height) + " px)");
+    fail(source, "camera.self_mask", error);
   }
   if (mask.cols != c.width || mask.rows != c.height) {
     fail(source, "camera.self_mask",
