@@ -1,8 +1,6 @@
 #include "act_color/core/calibration.hpp"
 
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
