@@ -1,11 +1,13 @@
 #include "act_color/core/calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "act_color/core/file_io.hpp"
 #include "act_color/core/yaml_subset.hpp"
@@ -41,7 +43,7 @@ class MapReader {
   const YamlNode& child(const std::string& name) {
     used_.insert(name);
     const YamlNode* n = node_->find(name);
-    if (n == nullptr) fail(source_, key(name), "missing");
+    if (n == nullptr) fail(source_, key(name), "missing" + misspelling(name));
     return *n;
   }
   bool has(const std::string& name) const { return node_->find(name) != nullptr; }
@@ -99,6 +101,28 @@ class MapReader {
   }
 
   const std::string& source() const { return source_; }
+
+  // For a missing key: a key of this map not read as another within two edits of it (a typo, an
+  // accent), named with its place, so that the message points at the line to fix; empty when there
+  // is none.
+  std::string misspelling(const std::string& name) const {
+    for (const auto& e : node_->entries) {
+      if (used_.count(e.first) || e.first.size() > name.size() + 2 || name.size() > e.first.size() + 2) continue;
+      std::vector<size_t> row(e.first.size() + 1);
+      for (size_t j = 0; j < row.size(); ++j) row[j] = j;
+      for (size_t i = 1; i <= name.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= e.first.size(); ++j) {
+          const size_t above = row[j];
+          row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (name[i - 1] == e.first[j - 1] ? 0 : 1)});
+          diagonal = above;
+        }
+      }
+      if (row.back() <= 2) return "; is '" + e.first + "'" + at(e.second) + " meant?";
+    }
+    return "";
+  }
 
   // What a node is, for messages: its text, shortened, or "a list" / "a map".
   static std::string describe(const YamlNode& n) {

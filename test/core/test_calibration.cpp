@@ -78,6 +78,12 @@ TEST(Calibration, MissingKeysAreRejectedByName) {
       errorOf(replaced(contractText(), "{width_m: 2.0, height_m: 1.0, depth_m: 0.5}", "{width_m: 2.0, height_m: 1.0}"))
           .find("field.goal.depth_m: missing"),
       std::string::npos);
+  // A misspelt key: the message names it and its place (it said only "camera.width: missing").
+  const std::string misspelt = std::string("w\xc3\xad") + "dth";  // an accented i
+  const std::string error = errorOf(replaced(contractText(), "  width: 580", "  " + misspelt + ": 580"));
+  EXPECT_NE(error.find("camera.width: missing; is '" + misspelt + "' (line 2, column 11) meant?"), std::string::npos)
+      << error;
+  EXPECT_EQ(errorOf(replaced(contractText(), "  height_m: 0.75", "")).find("meant"), std::string::npos);
 }
 
 TEST(Calibration, ElevationMapMustIncreaseStrictly) {
