@@ -128,6 +128,10 @@ bool lutPathInside(const std::string& dir, const std::string& requested, std::st
     *error = "not a file name";
     return false;
   }
+  if (requested.back() == '/') {
+    *error = "'" + requested + "' names a directory, not a file";
+    return false;
+  }
   std::error_code ec;
   fs::create_directories(dir, ec);
   const fs::path base = fs::weakly_canonical(fs::path(dir), ec);
@@ -140,7 +144,7 @@ bool lutPathInside(const std::string& dir, const std::string& requested, std::st
   // Resolves "..", "." and symbolic links of the existing part.
   const fs::path target = fs::weakly_canonical(p, ec);
   if (ec) {
-    *error = "cannot resolve '" + requested + "'";
+    *error = "cannot resolve '" + requested + "': " + ec.message();
     return false;
   }
   const fs::path rel = target.lexically_relative(base);

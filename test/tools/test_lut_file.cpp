@@ -174,6 +174,11 @@ TEST(LutFile, SavesStayInsideTheirFolderAndReplaceOnlyTables) {
                                  std::string("ok.lut\0/../../x", 15), std::string(""), std::string(".")}) {
     EXPECT_FALSE(conv::lutPathInside(dir, bad, &resolved, &error)) << bad;
   }
+  // Said as it is (they read "not inside ~lut_dir" and "cannot resolve").
+  EXPECT_FALSE(conv::lutPathInside(dir, "x.lut/", &resolved, &error));
+  EXPECT_EQ(error, "'x.lut/' names a directory, not a file");
+  EXPECT_FALSE(conv::lutPathInside(dir, std::string(300, 'a') + ".lut", &resolved, &error));
+  EXPECT_NE(error.find("File name too long"), std::string::npos) << error;
   // A symbolic link out of the folder is resolved, and refused.
   ASSERT_EQ(::symlink("/tmp", (dir + "/out").c_str()), 0);
   EXPECT_FALSE(conv::lutPathInside(dir, "out/escape.lut", &resolved, &error));
