@@ -148,7 +148,7 @@ void ActParams::validate() const {
   requireParameterRange("robot_height_m", robot_height_m, 0.0, 5.0);
   requireParameterRange("light_change_add_stride", light_change_add_stride, 1, 1 << 20);
   requireParameterRange("evidence_removal_ratio", evidence_removal_ratio, 0.0, 1000.0);
-  requireParameterRange("ball_diameter_m", ball_diameter_m, 0.05, 1.0);
+  requireParameterRange("ball_diameter_m", ball_diameter_m, kMinBallDiameterM, kMaxBallDiameterM);
 }
 
 void ActParams::set(const std::string& name, const std::string& value) {

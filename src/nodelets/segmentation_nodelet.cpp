@@ -23,6 +23,7 @@
 #include "act_color/ColorLut.h"
 #include "act_color/SegmentationConfig.h"
 #include "act_color/VisionFeatures.h"
+#include "act_color/core/act_trainer.hpp"
 #include "act_color/core/ball_detector.hpp"
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/feature_extractor.hpp"
@@ -216,8 +217,6 @@ bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* 
   fp.min_ball_pixels = c.min_ball_pixels;
   fp.obstacle_merge_m = c.obstacle_merge_m;
   std::ostringstream s;
-  // As the trainer's ball_diameter_m (cfg/ActTrainer.cfg).
-  constexpr double kMinBallDiameterM = 0.05, kMaxBallDiameterM = 1.0;
   if (!(c.queue_size >= 1 && c.queue_size <= 100)) {
     s << "parameter queue_size must be in [1, 100], is " << c.queue_size;
   } else if (!(c.max_wait >= 0.0 && c.max_wait <= 10.0)) {
@@ -226,11 +225,11 @@ bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* 
     s << "parameter table_history must be in [1, 100], is " << c.table_history;
   } else if (!(c.max_pose_age > 0.0 && c.max_pose_age <= 60.0)) {
     s << "parameter max_pose_age must be in (0, 60] s, is " << c.max_pose_age;
-  } else if (!(c.ball_diameter_m >= kMinBallDiameterM && c.ball_diameter_m <= kMaxBallDiameterM)) {
-    s << "parameter ball_diameter_m must be in [" << kMinBallDiameterM << ", " << kMaxBallDiameterM << "] m, is "
-      << c.ball_diameter_m;
   } else {
     try {
+      // As the trainer's (ActParams).
+      core::requireParameterRange("ball_diameter_m", c.ball_diameter_m, core::kMinBallDiameterM,
+                                  core::kMaxBallDiameterM);
       fp.validate();
     } catch (const std::exception& e) {
       s << e.what();

@@ -227,11 +227,11 @@ RealImageResult evaluateRealImage(const RealImage& image,
         fig.green_recall = carpet.empty() ? 0.0 : static_cast<double>(green) / carpet.size();
         fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
         fig.hall_as_black = hall.empty() ? 0.0 : static_cast<double>(black) / hall.size();
+        // The labels as the segmentation gives them: the table's, and the ball's image where the cycle
+        // saw it (the ball's figures, and the pictures).
+        segmenter.classify(lut, view, labels);
+        trainer.labelBall(stats, labels);
         if (image.ball) {
-          // The labels as the segmentation gives them: the table's, and the ball's image where the
-          // cycle saw it.
-          segmenter.classify(lut, view, labels);
-          trainer.labelBall(stats, labels);
           size_t inside = 0, inside_ball = 0, predicted = 0, predicted_near = 0;
           for (int i = 0; i < frame.rows * frame.cols; ++i) {
             const int u = i % frame.cols, v = i / frame.cols;
@@ -253,13 +253,11 @@ RealImageResult evaluateRealImage(const RealImage& image,
         figures.push_back(fig);
         if (first_mode && f == kRealFramesBefore + kRealFramesAfter - 1) {
           frame_last = frame.clone();
-          segmenter.classify(lut, view, labels_last);
-          trainer.labelBall(stats, labels_last);
+          labels_last = labels.clone();
         }
         if (result.labels_before.empty() && f == kRealFramesBefore - 1) {
           result.frame_before = frame.clone();
-          segmenter.classify(lut, view, result.labels_before);
-          trainer.labelBall(stats, result.labels_before);
+          result.labels_before = labels.clone();
           if (!image.nubot_table.empty()) {
             size_t imaged = 0, green = 0, black = 0;
             for (int i = 0; i < frame.rows * frame.cols; ++i) {

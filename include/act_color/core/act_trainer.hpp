@@ -19,6 +19,9 @@
 namespace act_color {
 namespace core {
 
+// The range of ActParams::ball_diameter_m (and of the segmentation's, which must equal it).
+constexpr double kMinBallDiameterM = 0.05, kMaxBallDiameterM = 1.0;
+
 // Parameters of ACT; defaults are the paper's. validate() throws std::invalid_argument naming
 // the parameter and its allowed range.
 struct ActParams {
@@ -111,7 +114,7 @@ struct ActParams {
   // updates the cluster (eq. 4, 5) and adds its colors (2.3); the ball never takes a color of
   // another class, and 2.4 removes its colors seen off the field like the others'.
   bool ball_training = true;
-  double ball_diameter_m = 0.22;
+  double ball_diameter_m = 0.22;  // in [kMinBallDiameterM, kMaxBallDiameterM]
 
   void validate() const;
   // Sets the parameter `name` (as the field is named) from text; throws std::invalid_argument for
