@@ -446,5 +446,14 @@ void saveSelfMask(const CameraCalibration& camera, const std::string& path) {
   if (!written) throw CalibrationError(path + ": cannot write the self mask");
 }
 
+bool PoseBounds::contains(double x_m, double y_m, std::string* why) const {
+  if (std::abs(x_m) <= half_x_m && std::abs(y_m) <= half_y_m) return true;
+  std::ostringstream s;
+  s << "pose (" << x_m << ", " << y_m << ") m is off the field (|x| <= " << half_x_m << ", |y| <= " << half_y_m
+    << " m with the margin)";
+  *why = s.str();
+  return false;
+}
+
 }  // namespace core
 }  // namespace act_color

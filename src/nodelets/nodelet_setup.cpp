@@ -70,8 +70,7 @@ core::Calibration loadCalibrationParam(const ros::NodeHandle& pnh, PoseSource* p
   } catch (const std::exception& e) {
     throw std::runtime_error(std::string("bad calibration: ") + e.what());
   }
-  const core::FieldCalibration& f = calibration.field;
-  pose_source->setFieldBounds(0.5 * f.length_m + f.margin_m + 1.0, 0.5 * f.width_m + f.margin_m + 1.0);
+  pose_source->setFieldBounds(core::PoseBounds(calibration.field));
   return calibration;
 }
 

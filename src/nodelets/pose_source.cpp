@@ -147,19 +147,13 @@ void PoseSource::forgetNewerThan(const ros::Time& stamp) {
   }
 }
 
-void PoseSource::setFieldBounds(double half_x_m, double half_y_m) {
+void PoseSource::setFieldBounds(const core::PoseBounds& bounds) {
   std::lock_guard<std::mutex> lock(mutex_);
-  half_x_m_ = half_x_m;
-  half_y_m_ = half_y_m;
+  bounds_ = bounds;
 }
 
 bool PoseSource::plausible(const core::Pose2D& pose, std::string* why) const {
-  if (std::abs(pose.x_m) <= half_x_m_ && std::abs(pose.y_m) <= half_y_m_) return true;
-  std::ostringstream s;
-  s << "pose (" << pose.x_m << ", " << pose.y_m << ") m is off the field (|x| <= " << half_x_m_
-    << ", |y| <= " << half_y_m_ << " m with the margin)";
-  *why = s.str();
-  return false;
+  return bounds_.contains(pose.x_m, pose.y_m, why);
 }
 
 void PoseSource::setMaxAge(double max_age_s) {

@@ -217,9 +217,7 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
   // Poses by stamp (small), truth and events indexed by stamp and read when needed. A pose that is
   // no robot's on this field (NaN, tilted, off the field and its margin, as the nodelets check) is
   // not used, and said why.
-  const core::FieldCalibration& field = calibration.field;
-  const double half_x = 0.5 * field.length_m + field.margin_m + 1.0,
-               half_y = 0.5 * field.width_m + field.margin_m + 1.0;
+  const core::PoseBounds bounds(calibration.field);
   std::vector<StampedPose> poses;
   size_t unusable_poses = 0;
   for (const rosbag::MessageInstance& m : rosbag::View(in, rosbag::TopicQuery(options.pose_topic))) {
@@ -227,13 +225,7 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
     StampedPose p{msg->header.stamp, false, {}};
     std::string error;
     p.valid = ros_conversions::pose2D(msg->pose.pose, &p.pose, &error);
-    if (p.valid && !(std::abs(p.pose.x_m) <= half_x && std::abs(p.pose.y_m) <= half_y)) {
-      p.valid = false;
-      std::ostringstream s;
-      s << "pose (" << p.pose.x_m << ", " << p.pose.y_m << ") m is off the field (|x| <= " << half_x
-        << ", |y| <= " << half_y << " m with the margin)";
-      error = s.str();
-    }
+    if (p.valid) p.valid = bounds.contains(p.pose.x_m, p.pose.y_m, &error);
     if (!p.valid) {
       std::ostringstream at;
       at << options.pose_topic << " at " << p.stamp << ": " << error << "; not used";

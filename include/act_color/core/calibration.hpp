@@ -70,6 +70,18 @@ struct FieldCalibration {
   int yellow_goal_x_sign = 1;
 };
 
+// Where a robot's pose may lie: the carpet (outer lines plus margin_m) and kPoseMarginM beyond it,
+// as half extents about the centre spot; a pose outside is no robot's on this field.
+constexpr double kPoseMarginM = 1.0;
+struct PoseBounds {
+  double half_x_m = 1e9, half_y_m = 1e9;
+  explicit PoseBounds(const FieldCalibration& f)
+      : half_x_m(0.5 * f.length_m + f.margin_m + kPoseMarginM), half_y_m(0.5 * f.width_m + f.margin_m + kPoseMarginM) {}
+  PoseBounds() = default;
+  // False with a reason for a pose outside.
+  bool contains(double x_m, double y_m, std::string* why) const;
+};
+
 struct Calibration {
   CameraCalibration camera;
   FieldCalibration field;

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <string>
 
+#include "act_color/core/calibration.hpp"
 #include "act_color/core/types.hpp"
 
 namespace act_color {
@@ -37,8 +38,8 @@ class PoseSource {
   // mode, tf's buffer when it holds such transforms.
   void forgetNewerThan(const ros::Time& stamp);
   void setMaxAge(double max_age_s);
-  // Poses beyond |x| <= half_x_m, |y| <= half_y_m (the carpet plus a margin) are rejected.
-  void setFieldBounds(double half_x_m, double half_y_m);
+  // Poses outside these bounds (the carpet plus a margin, core::PoseBounds) are rejected.
+  void setFieldBounds(const core::PoseBounds& bounds);
   // Times the pose stamps jumped back by more than a second (a new replay); reset() was called.
   uint64_t timeJumps() const;
 
@@ -57,7 +58,7 @@ class PoseSource {
   Mode mode_ = Mode::kTopic;
   std::string name_;
   double max_age_s_ = 1.0;
-  double half_x_m_ = 1e9, half_y_m_ = 1e9;
+  core::PoseBounds bounds_;  // everywhere until the calibration is loaded
   std::string field_frame_ = "field";
   std::string base_frame_ = "base_link";
   ros::Subscriber sub_;
