@@ -55,12 +55,16 @@ class Parser {
   }
 
   // Splits into lines: checks characters and indentation, strips comments, skips blank lines.
+  // Lines end in LF, CR LF, or CR alone (old Mac editors) when the file has no LF; a UTF-8 byte
+  // order mark before the first line is skipped.
   void split(const std::string& text) {
+    static const std::string kByteOrderMark = "\xEF\xBB\xBF";
+    const char line_end = text.find('\n') == std::string::npos && text.find('\r') != std::string::npos ? '\r' : '\n';
     int number = 0;
-    size_t start = 0;
+    size_t start = text.compare(0, kByteOrderMark.size(), kByteOrderMark) == 0 ? kByteOrderMark.size() : 0;
     bool first = true;
     while (start <= text.size()) {
-      size_t end = text.find('\n', start);
+      size_t end = text.find(line_end, start);
       if (end == std::string::npos) end = text.size();
       ++number;
       const std::string raw = text.substr(start, end - start);

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "act_color/core/calibration.hpp"
@@ -233,6 +234,24 @@ TEST(Calibration, NestingSizeAndSyntaxAreBoundedAndLocated) {
       << errorOf("camera:\n  width: 1\n   height: 2\n");
   EXPECT_NE(errorOf("camera: &a {x: 1}\nfield: *a\n").find("anchors, aliases"), std::string::npos);
   EXPECT_NE(errorOf("camera:\n\twidth: 1\n").find("line 2, column 1: a tab"), std::string::npos);
+}
+
+TEST(Calibration, ByteOrderMarkAndAnyLineEndsRead) {
+  // Editors on other systems save with a UTF-8 byte order mark, CR LF or (old Mac) CR alone.
+  const std::string text = contractText();
+  auto with_ends = [&](const std::string& end) {
+    std::string out;
+    for (const char c : text) out += c == '\n' ? end : std::string(1, c);
+    return out;
+  };
+  EXPECT_EQ(errorOf("\xEF\xBB\xBF" + text), "");
+  EXPECT_EQ(errorOf(with_ends("\r\n")), "");
+  EXPECT_EQ(errorOf(with_ends("\r")), "");
+  // A CR-only file's errors name their line as in the editor.
+  const std::string bad = replaced(with_ends("\r"), "  height_m: 0.75", "  height_m: [0.75");
+  const size_t line =
+      static_cast<size_t>(std::count(text.begin(), text.begin() + text.find("  height_m: 0.75"), '\n')) + 1;
+  EXPECT_NE(errorOf(bad).find("line " + std::to_string(line) + ","), std::string::npos) << errorOf(bad);
 }
 
 TEST(Calibration, ValuesAreReadInTheirRealType) {
