@@ -359,6 +359,10 @@ std::string ActTrainer::clustersProblem(const std::vector<SavedCluster>& cluster
 void ActTrainer::restore(const ColorLut& lut, const std::vector<SavedCluster>& clusters, uint64_t revision) {
   const std::string problem = clustersProblem(clusters);
   if (!problem.empty()) throw std::invalid_argument(problem);
+  if (revision > kMaxRevision) {
+    throw std::invalid_argument("revision " + std::to_string(revision) + " is above " + std::to_string(kMaxRevision) +
+                                " (two years of cycles at 30 Hz): not a saved state");
+  }
   loadTable(lut);
   for (ClassCluster& cluster : clusters_) cluster.reset(255.0);
   const auto counts = lut_.cellCounts();

@@ -193,6 +193,23 @@ Table loadTable(const std::string& path) {
   return t;
 }
 
+// A name from a file as it may be printed: bytes outside printable ASCII as \xNN (no terminal
+// escapes, no line breaks from a forged frame id).
+std::string printable(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f && byte != '\\') {
+      out += c;
+    } else {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+      out += escaped;
+    }
+  }
+  return out;
+}
+
 const char* spaceName(core::ColorSpace space) { return space == core::ColorSpace::kYuv ? "yuv" : "rgb"; }
 
 // ---------------------------------------------------------------------------------------------
@@ -210,7 +227,7 @@ int info(const std::string& path) {
   std::printf("revision: %llu\n", static_cast<unsigned long long>(t.msg.revision));
   std::printf("stamp: %u.%09u%s%s%s\n", t.msg.header.stamp.sec, t.msg.header.stamp.nsec,
               t.msg.header.stamp.isZero() ? " (not set)" : "", t.msg.header.frame_id.empty() ? "" : ", frame ",
-              t.msg.header.frame_id.c_str());
+              printable(t.msg.header.frame_id).c_str());
   std::printf("cells per class:\n");
   const auto counts = lut.cellCounts();
   size_t classified = 0;

@@ -509,6 +509,10 @@ TEST_F(ActTrainerTest, ARestoredStateGoesOnWhereItStopped) {
     ActTrainer c(cal);
     EXPECT_THROW(c.restore(a.lut(), {bad}, 5), std::invalid_argument);
   }
+  // A revision past the 32-bit cycle stamps' reach is no saved state.
+  ActTrainer c(cal);
+  EXPECT_NO_THROW(c.restore(a.lut(), saved, ActTrainer::kMaxRevision));
+  EXPECT_THROW(c.restore(a.lut(), saved, ActTrainer::kMaxRevision + 1), std::invalid_argument);
 }
 
 // The removal step reads packed rgb8 and bgr8 images by pixel index and other layouts by row and

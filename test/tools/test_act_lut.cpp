@@ -212,6 +212,17 @@ TEST(ActLut, InfoPrintsTheTableAndItsClusters) {
     }
   }
   EXPECT_EQ(clusters, 6) << r.output;
+
+  // A frame id with terminal escapes and a line break is printed escaped, not raw.
+  const std::string forged = tempDir() + "/forged_frame.lut";
+  act_color::ColorLutPtr msg = saveTable(boxTable(core::ColorSpace::kRgb), forged);
+  msg->header.frame_id = "field\x1b[2J\nrevision: 7";
+  std::string error;
+  ASSERT_TRUE(conv::saveLutFile(*msg, forged, &error)) << error;
+  const ToolRun escaped = run("info " + forged);
+  ASSERT_EQ(escaped.exit_code, 0) << escaped.output;
+  EXPECT_NE(escaped.output.find("frame field\\x1b[2J\\x0arevision: 7\n"), std::string::npos) << escaped.output;
+  EXPECT_EQ(escaped.output.find('\x1b'), std::string::npos);
 }
 
 TEST(ActLut, ExportDrawsSlicesInThePaletteColors) {
@@ -527,6 +538,14 @@ TEST(ActLut, BadFilesExitOneWithAMessage) {
   msg = saveTable(boxTable(core::ColorSpace::kRgb), twice);
   msg->clusters[1].class_id = msg->clusters[0].class_id;
   ASSERT_TRUE(conv::saveLutFile(*msg, twice, &error)) << error;
+  // A stamp no clock gives, a revision that would wrap the trainer's cycle stamps.
+  const std::string bad_nsec = tempDir() + "/bad_nsec.lut", bad_revision = tempDir() + "/bad_revision.lut";
+  msg = saveTable(boxTable(core::ColorSpace::kRgb), bad_nsec);
+  msg->header.stamp.nsec = 4294967295u;
+  ASSERT_TRUE(conv::saveLutFile(*msg, bad_nsec, &error)) << error;
+  msg = saveTable(boxTable(core::ColorSpace::kRgb), bad_revision);
+  msg->revision = ~uint64_t{0};
+  ASSERT_TRUE(conv::saveLutFile(*msg, bad_revision, &error)) << error;
 
   const std::vector<std::pair<std::string, std::string>> cases = {
       {truncated, "truncated or corrupt"},
@@ -535,6 +554,8 @@ TEST(ActLut, BadFilesExitOneWithAMessage) {
       {inconsistent, "table has 10 cells, expected 262144"},
       {nan_sigma, "is not a cluster of a class 1-6"},
       {twice, "two clusters of class 1"},
+      {bad_nsec, "stamp has 4294967295 nanoseconds"},
+      {bad_revision, "revision 18446744073709551615 is above 2147483648"},
   };
   for (const auto& c : cases) {
     const ToolRun info = run("info " + c.first);

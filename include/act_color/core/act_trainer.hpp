@@ -214,10 +214,14 @@ class ActTrainer {
   // The first problem of a saved state's clusters: one's (SavedCluster::problem) or a class given
   // twice; empty when there is none.
   static std::string clustersProblem(const std::vector<SavedCluster>& clusters);
+  // The largest revision a saved state may have: cycles are stamped in 32 bits (the removal
+  // protection, the kept lights), and 2^31 cycles are two years at 30 Hz.
+  static constexpr uint64_t kMaxRevision = uint64_t{1} << 31;
   // Installs a saved state: the table, the clusters it was trained with and its revision, so that
   // training goes on where it stopped. A class whose cluster is not given, or that has no cell in
-  // the table, starts at eq. 2-3. Throws std::invalid_argument for sizes that differ or a cluster
-  // that is not one (class id, NaN, sigma <= 0, mean outside the channel range).
+  // the table, starts at eq. 2-3. Throws std::invalid_argument for sizes that differ, a cluster
+  // that is not one (class id, NaN, sigma <= 0, mean outside the channel range) or a revision
+  // above kMaxRevision.
   void restore(const ColorLut& lut, const std::vector<SavedCluster>& clusters, uint64_t revision);
 
   const ColorLut& lut() const { return lut_; }
