@@ -93,18 +93,18 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool requestPath(const FilePath::Request& req, FilePath::Response& res, std::string* path) const;
   bool onSaveLut(FilePath::Request& req, FilePath::Response& res);
   bool onLoadLut(FilePath::Request& req, FilePath::Response& res);
-  // A table file: saveLut = prepareSave (the table and the file inside ~lut_dir, under the lock)
-  // + writeTable (the file I/O alone); loadLut = loadPath + readTable (the file I/O alone) +
-  // installTable (under the lock). The services run the I/O parts with a timeout.
+  // A table file: saveLut = prepareSave (the table and ~lut_dir, under the lock) + writeTable (the
+  // file inside ~lut_dir and its I/O, touching the file system only); loadLut = loadPath + readTable (the file I/O
+  // alone) + installTable (under the lock). The services run the I/O parts with a timeout.
   struct LoadedTable {
     act_color::ColorLut msg;
     core::ColorLut lut;
     std::vector<core::ActTrainer::SavedCluster> clusters;
   };
   bool saveLut(const std::string& path, std::string* message);
-  bool prepareSave(const std::string& requested, act_color::ColorLutPtr* msg, std::string* path,
-                   std::string* message) const;
-  static bool writeTable(const act_color::ColorLut& msg, const std::string& path, std::string* message);
+  bool prepareSave(act_color::ColorLutPtr* msg, std::string* lut_dir, std::string* message) const;
+  static bool writeTable(const act_color::ColorLut& msg, const std::string& lut_dir, const std::string& requested,
+                         std::string* message);
   bool loadLut(const std::string& path, std::string* message);
   std::string loadPath(const std::string& requested) const;
   static bool readTable(const std::string& path, LoadedTable* table, std::string* message);
@@ -819,10 +819,8 @@ void ActTrainerNodelet::publishFieldMarkers(const core::FieldModel& field) {
   field_pub_.publish(markers);
 }
 
-bool ActTrainerNodelet::prepareSave(const std::string& requested, act_color::ColorLutPtr* msg, std::string* path,
-                                    std::string* message) const {
+bool ActTrainerNodelet::prepareSave(act_color::ColorLutPtr* msg, std::string* lut_dir, std::string* message) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!ros_conversions::lutPathInside(lut_dir_, requested, path, message)) return false;
   if (!trainer_ || !has_table_) {
     *message = trainer_ ? "no table trained yet" : notReady();
     return false;
@@ -830,10 +828,14 @@ bool ActTrainerNodelet::prepareSave(const std::string& requested, act_color::Col
   std_msgs::Header header;
   header.stamp = image_time_.latest();
   *msg = ros_conversions::toMsg(*trainer_, header);
+  *lut_dir = lut_dir_;
   return true;
 }
 
-bool ActTrainerNodelet::writeTable(const act_color::ColorLut& msg, const std::string& path, std::string* message) {
+bool ActTrainerNodelet::writeTable(const act_color::ColorLut& msg, const std::string& lut_dir,
+                                   const std::string& requested, std::string* message) {
+  std::string path;
+  if (!ros_conversions::lutPathInside(lut_dir, requested, &path, message)) return false;
   if (!ros_conversions::saveLutFile(msg, path, message)) return false;
   *message = "saved the color table (revision " + std::to_string(msg.revision) + ") and its clusters to " + path;
   return true;
@@ -841,8 +843,8 @@ bool ActTrainerNodelet::writeTable(const act_color::ColorLut& msg, const std::st
 
 bool ActTrainerNodelet::saveLut(const std::string& requested, std::string* message) {
   act_color::ColorLutPtr msg;
-  std::string path;
-  return prepareSave(requested, &msg, &path, message) && writeTable(*msg, path, message);
+  std::string lut_dir;
+  return prepareSave(&msg, &lut_dir, message) && writeTable(*msg, lut_dir, requested, message);
 }
 
 std::string ActTrainerNodelet::loadPath(const std::string& requested) const {
@@ -945,12 +947,12 @@ bool ActTrainerNodelet::onSaveLut(FilePath::Request& req, FilePath::Response& re
   std::string path;
   if (!requestPath(req, res, &path)) return true;
   act_color::ColorLutPtr msg;
-  std::string file;
-  // Only the file operation on the I/O thread: it touches nothing of the nodelet, which may be
-  // gone when a hanging file system lets it finish.
-  res.success =
-      prepareSave(path, &msg, &file, &res.message) &&
-      withTimeout([msg, file](std::string* m) { return writeTable(*msg, file, m); }, kFileTimeoutS, &res.message);
+  std::string lut_dir;
+  // Every file system call (the folder's checks too) on the I/O thread, without the lock: it
+  // touches nothing of the nodelet, which may be gone when a hanging file system lets it finish.
+  res.success = prepareSave(&msg, &lut_dir, &res.message) &&
+                withTimeout([msg, lut_dir, path](std::string* m) { return writeTable(*msg, lut_dir, path, m); },
+                            kFileTimeoutS, &res.message);
   if (!res.success) NODELET_ERROR("~save_lut: %s", res.message.c_str());
   return true;
 }

@@ -277,6 +277,23 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
         if (loading()) ACT_WALL_THROTTLE(2.0, NODELET_INFO("image dropped: the calibration is still loading"));
         return;
       }
+      // An image no table can classify is refused now, not after waiting ~max_wait for its table.
+      std::string problem = ros_conversions::imageMessageProblem(*msg);
+      if (problem.empty() && (msg->width != static_cast<uint32_t>(camera_->width()) ||
+                              msg->height != static_cast<uint32_t>(camera_->height()))) {
+        problem = "image is " + std::to_string(msg->width) + "x" + std::to_string(msg->height) +
+                  " px, the calibration is for " + std::to_string(camera_->width()) + "x" +
+                  std::to_string(camera_->height());
+      }
+      if (!problem.empty()) {
+        ++images_;
+        ++rejected_;
+        last_error_ = problem;
+        record(TableUsed::kRejected, 0.0, -1.0);
+        ACT_WALL_THROTTLE(
+            5.0, NODELET_ERROR("image stamped %.3f not classified: %s", msg->header.stamp.toSec(), problem.c_str()));
+        return;
+      }
       const ros::Time before = image_time_.latest();
       if (image_time_.jumpedBack(msg->header.stamp)) {
         // A new replay: the old run's tables are stamped in this run's future and would be taken
@@ -437,11 +454,6 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
       }
       core::labelBallImage(*camera_, radius_m, ball->x_m, ball->y_m, labels);
     }
-  } else if (image->width != static_cast<uint32_t>(camera_->width()) ||
-             image->height != static_cast<uint32_t>(camera_->height())) {
-    throw std::invalid_argument("image is " + std::to_string(image->width) + "x" + std::to_string(image->height) +
-                                " px, the calibration is for " + std::to_string(camera_->width()) + "x" +
-                                std::to_string(camera_->height()));
   }
   const double classify_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
