@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "act_color/core/pixel_lattice.hpp"
 
@@ -1195,6 +1196,9 @@ bool ballCandidate(const BallBlob& b, bool ball_lost) {
 constexpr uint32_t kBallMemoryCycles = 15;
 // A trained ball not seen for this many cycles is lost: evidence may seed it again.
 constexpr uint32_t kBallLostCycles = 8;
+// A sighting within this distance per cycle since the last one is the same ball (MSL balls roll
+// at up to about 10 m/s: 0.33 m a frame at 30 Hz).
+constexpr double kBallTrackGateM = 0.5;
 // A blob's color matches a hypothesis within this many of its spreads, at least kBallMatchMin units.
 constexpr double kBallMatchSpreads = 2.5;
 constexpr double kBallMatchMin = 20.0;
@@ -1251,14 +1255,23 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
   }
 
   // The ball: a blob of its shape whose color the ball's cluster includes (within zeta sigma); of
-  // several, the one with most pixels of the ball's class, then the largest. Without a cluster (a
-  // loaded table), the blob with most pixels of the class.
+  // several, the one where the ball was last seen (a marker or poster of its color elsewhere), then
+  // the one with most pixels of the ball's class, then the largest. Without a cluster (a loaded
+  // table), the blob with most pixels of the class.
+  const bool tracked = ball.trained() && ball_last_seen_ != 0 && now - ball_last_seen_ <= kBallLostCycles;
+  auto nearTrack = [&](const BallBlob& b) {
+    if (!tracked) return false;
+    Eigen::Vector2d place;
+    transform.apply(b.base_x_m, b.base_y_m, &place.x(), &place.y());
+    return (place - ball_last_place_).norm() <= kBallTrackGateM * (now - ball_last_seen_);
+  };
+  auto rank = [&](const BallBlob& b) { return std::make_tuple(nearTrack(b), b.ball_pixels, b.pixels); };
   const BallBlob* seen = nullptr;
   for (const BallBlob& b : ball_blobs_) {
     if (!ballSighting(b)) continue;
     if (ball.trained() ? (b.median - ball.mean()).norm() >= params_.zeta * ball.sigma() : b.ball_pixels * 2 < b.pixels)
       continue;
-    if (!seen || std::make_pair(b.ball_pixels, b.pixels) > std::make_pair(seen->ball_pixels, seen->pixels)) seen = &b;
+    if (!seen || rank(b) > rank(*seen)) seen = &b;
   }
   auto train = [&](const BallBlob& b) {
     std::vector<Eigen::Vector3f>& colors = samples_[kOrange];
@@ -1293,6 +1306,7 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
     stats.ball.v = seen->centroid_v;
     stats.ball.pixels = seen->ball_pixels;
     ball_last_seen_ = now;
+    transform.apply(seen->base_x_m, seen->base_y_m, &ball_last_place_.x(), &ball_last_place_.y());
     train(*seen);
   }
 

@@ -33,12 +33,14 @@ constexpr double kMaxBallExtent = 2.0;
 // position may be a few pixels off (tuning split: 1.5 and 3 gave the same figures).
 constexpr double kOneBallReach = 1.5;
 
-constexpr uint8_t kNoSector = 255;   // BallDetector::sectors_ of a pixel that does not see the floor
-constexpr uint8_t kGridOff = 0;      // not on the carpet, or not a grid point
-constexpr uint8_t kGridBall = 1;     // unknown or the ball's class
-constexpr uint8_t kGridCarpet = 2;   // green or white
-constexpr uint8_t kGridOther = 3;    // another class
-constexpr uint8_t kGridVisited = 4;  // a ball grid point already in a component
+constexpr uint8_t kNoSector = 255;     // BallDetector::sectors_ of a pixel that does not see the floor
+constexpr uint8_t kGridOff = 0;        // not on the carpet, or not a grid point
+constexpr uint8_t kGridBall = 1;       // unknown
+constexpr uint8_t kGridCarpet = 2;     // green or white
+constexpr uint8_t kGridOther = 3;      // another class
+constexpr uint8_t kGridVisited = 4;    // a ball grid point already in a component
+constexpr uint8_t kGridBallClass = 5;  // the ball's class
+bool ballPoint(uint8_t g) { return g == kGridBall || g == kGridBallClass; }
 
 bool ballCandidate(uint8_t k) { return k == kUnknown || k == kOrange; }
 
@@ -260,8 +262,11 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
         uint8_t c[3];
         pixels.color(p.pixel, p.u, p.v, c);
         const uint8_t k = classOf(lut, known, c);
-        g = ballCandidate(k) ? kGridBall : (k == kGreen || k == kWhite) ? kGridCarpet : kGridOther;
-        if (g == kGridBall) ball_points_.push_back(p.cell);
+        g = k == kOrange                   ? kGridBallClass
+            : k == kUnknown                ? kGridBall
+            : (k == kGreen || k == kWhite) ? kGridCarpet
+                                           : kGridOther;
+        if (ballPoint(g)) ball_points_.push_back(p.cell);
       } else if (look_off_field) {
         lookOffField(p);
       }
@@ -276,8 +281,9 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
   component_.clear();
   const size_t max_points = static_cast<size_t>(kMaxAreaFactor * max_area_px_ / (stride_ * stride_)) + 4;
   for (const uint32_t start : ball_points_) {
-    if (grid_[start] != kGridBall) continue;
+    if (!ballPoint(grid_[start])) continue;
     const size_t begin = component_.size();
+    bool of_class = grid_[start] == kGridBallClass;
     stack_.assign(1, start);
     grid_[start] = kGridVisited;
     while (!stack_.empty()) {
@@ -290,7 +296,8 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
           const int x = gx + dx, y = gy + dy;
           if (x < 0 || y < 0 || x >= grid_w_ || y >= grid_h_) continue;
           const uint32_t n = static_cast<uint32_t>(y * grid_w_ + x);
-          if (grid_[n] != kGridBall) continue;
+          if (!ballPoint(grid_[n])) continue;
+          of_class = of_class || grid_[n] == kGridBallClass;
           grid_[n] = kGridVisited;
           stack_.push_back(n);
         }
@@ -300,10 +307,13 @@ void BallDetector::detect(const ExpectedClassModel& model, const ImageView& imag
       component_.resize(begin);  // far larger than a ball: an untrained region
       continue;
     }
-    components_.push_back({begin, component_.size()});
+    components_.push_back({begin, component_.size(), of_class});
   }
-  std::sort(components_.begin(), components_.end(),
-            [](const Component& a, const Component& b) { return a.end - a.begin > b.end - b.begin; });
+  // Those with a point of the ball's class first: a small far ball of one or two grid points is
+  // otherwise one of many specks of noise on a dark carpet, looked at in some cycles only.
+  std::sort(components_.begin(), components_.end(), [](const Component& a, const Component& b) {
+    return std::make_pair(a.of_ball_class, a.end - a.begin) > std::make_pair(b.of_ball_class, b.end - b.begin);
+  });
   if (components_.size() > kMaxBlobs) components_.resize(kMaxBlobs);
   for (const Component& c : components_) {
     seeds_.clear();

@@ -488,7 +488,8 @@ class ActTrainer {
     double log_radial = 0, log_tangential = 0;
   };
   std::vector<BallHypothesis> ball_hypotheses_;
-  uint32_t ball_last_seen_ = 0;  // cycle of the last sighting
+  uint32_t ball_last_seen_ = 0;            // cycle of the last sighting
+  Eigen::Vector2d ball_last_place_{0, 0};  // where, on the field
 };
 
 }  // namespace core

@@ -152,7 +152,8 @@ class BallDetector {
   std::vector<uint32_t> stack_;
   std::vector<uint32_t> component_;
   struct Component {
-    size_t begin, end;  // in component_
+    size_t begin, end;   // in component_
+    bool of_ball_class;  // a point of the ball's class
   };
   std::vector<Component> components_;
   std::vector<uint32_t> seeds_;   // the pixels of one component's grid points
