@@ -1,9 +1,11 @@
 // The segmentation nodelet alone, fed by the test as the ACT trainer would feed it: the ball the
 // trainer saw in an image (/act/ball) is labelled as the ball's image in that image's labels
-// (core::labelBallImage), and in no other image's.
+// (core::labelBallImage), and in no other image's; an image no table can classify is refused
+// when it comes.
 #include <geometry_msgs/PointStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/Image.h>
 
 #include <map>
@@ -85,6 +87,38 @@ TEST(Segmentation, LabelsTheBallTheTrainerSaw) {
   };
   EXPECT_EQ(orange(seen), static_cast<int>(ball_pixels));
   EXPECT_EQ(orange(unseen), 0);
+}
+
+TEST(Segmentation, RefusesAnImageNoTableCanClassifyOnArrival) {
+  // segmentation.test sets ~max_wait to 5 s. An image of an encoding no table classifies is
+  // refused when it comes, not after waiting that long for its table.
+  ros::NodeHandle nh;
+  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/omni/image_raw", 10);
+  act_color_test::Waiter waiter;
+  ros::WallTime refused;
+  ros::Subscriber log_sub = nh.subscribe<rosgraph_msgs::Log>("/rosout", 100, [&](const rosgraph_msgs::LogConstPtr& m) {
+    if (m->level < rosgraph_msgs::Log::ERROR || m->msg.find("unsupported encoding 'mono16'") == std::string::npos)
+      return;
+    std::lock_guard<std::mutex> lock(waiter.mutex());
+    if (refused.isZero()) refused = ros::WallTime::now();
+    waiter.notify();
+  });
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  ASSERT_TRUE(
+      waiter.waitFor(30.0, [&] { return image_pub.getNumSubscribers() > 0 && log_sub.getNumPublishers() > 0; }));
+  sensor_msgs::Image image;
+  image.width = 580;
+  image.height = 580;
+  image.encoding = "mono16";
+  image.step = 2 * image.width;
+  image.data.assign(static_cast<size_t>(image.step) * image.height, 0);
+  image.header.stamp = ros::Time(2000, 0);
+  const ros::WallTime sent = ros::WallTime::now();
+  image_pub.publish(image);
+  ASSERT_TRUE(waiter.waitFor(20.0, [&] { return !refused.isZero(); })) << "no error for the mono16 image";
+  std::lock_guard<std::mutex> lock(waiter.mutex());
+  EXPECT_LT((refused - sent).toSec(), 2.5) << "refused only after waiting for a table";
 }
 
 }  // namespace
