@@ -1351,7 +1351,8 @@ void ActTrainer::trainBall(const ImageView& image, const PoseTransform& transfor
     const bool enough =
         match->frames >= kBallSeedFrames &&
         (static_cast<int>(match->places.size()) >= kBallSeedPlaces || match->frames >= 2 * kBallSeedFrames) &&
-        match->log_radial <= max_log_extent && match->log_tangential <= max_log_extent;
+        match->log_radial <= max_log_extent && match->log_tangential <= max_log_extent &&
+        std::abs(match->log_radial - match->log_tangential) <= std::log(kBallSeedMaxMeanElongation) * match->frames;
     if (enough && ball_lost && !seen) {
       ball.set(match->mean, std::max(params_.sigma_min, match->spread), true);
       stats.ball_seeded = true;

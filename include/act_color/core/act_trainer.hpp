@@ -161,11 +161,14 @@ struct CycleStats {
 // are, on average, no larger than a ball: one frame's noise or blur widens a ball's blob, but a
 // ball is not wider frame after frame (a shadow across the carpet's edge, tuning scene 17, was
 // 1.8 times as wide as a ball on average and seeded a ball where there was none; the balls that
-// seed on the tuning split measure at most 1.43).
+// seed on the tuning split measure at most 1.43). And round: a mirror strut seen between the
+// lines is a blob as long as a ball radially and half as wide, 2.6 times as long as wide on
+// average (fresh scene 2031 seeded its struts' blue-grey once 16 blobs a cycle were measured).
 constexpr int kBallSeedFrames = 6;
 constexpr int kBallSeedPlaces = 2;
 constexpr double kBallPlaceSpacingM = 0.3;
 constexpr double kBallSeedMaxMeanExtent = 1.5;
+constexpr double kBallSeedMaxMeanElongation = 2.0;
 
 // ActParams::pose_check. A frame is refused when the share of its samples that contradict the table
 // is above kPoseContradiction and above kPoseContradictionRatio times its running level over the
