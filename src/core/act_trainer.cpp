@@ -357,13 +357,17 @@ std::string ActTrainer::clustersProblem(const std::vector<SavedCluster>& cluster
   return "";
 }
 
+std::string ActTrainer::revisionProblem(uint64_t revision) {
+  if (revision <= kMaxRevision) return "";
+  return "revision " + std::to_string(revision) + " is above " + std::to_string(kMaxRevision) +
+         " (two years of cycles at 30 Hz)";
+}
+
 void ActTrainer::restore(const ColorLut& lut, const std::vector<SavedCluster>& clusters, uint64_t revision) {
   const std::string problem = clustersProblem(clusters);
   if (!problem.empty()) throw std::invalid_argument(problem);
-  if (revision > kMaxRevision) {
-    throw std::invalid_argument("revision " + std::to_string(revision) + " is above " + std::to_string(kMaxRevision) +
-                                " (two years of cycles at 30 Hz): not a saved state");
-  }
+  const std::string revision_problem = revisionProblem(revision);
+  if (!revision_problem.empty()) throw std::invalid_argument(revision_problem);
   loadTable(lut);
   for (ClassCluster& cluster : clusters_) cluster.reset(255.0);
   const auto counts = lut_.cellCounts();
@@ -974,12 +978,8 @@ ActTrainer::Evidence& ActTrainer::evidence(uint32_t cell) {
 void ActTrainer::checkImage(const ImageView& image) const {
   const auto& camera = model_.camera();
   if (image.data == nullptr) throw std::invalid_argument("empty image");
-  if (image.width != camera.width() || image.height != camera.height()) {
-    std::ostringstream s;
-    s << "image is " << image.width << "x" << image.height << " px, the calibration is for " << camera.width() << "x"
-      << camera.height();
-    throw std::invalid_argument(s.str());
-  }
+  const std::string size = imageSizeProblem(image.width, image.height, camera.width(), camera.height());
+  if (!size.empty()) throw std::invalid_argument(size);
   if (image.step < bytesPerPixel(image.format) * image.width)
     throw std::invalid_argument("image row step is too small");
   if (image.format == PixelFormat::kUyvy && image.width % 2 != 0)

@@ -11,6 +11,12 @@ ColorSpace nativeColorSpace(PixelFormat format) {
   return format == PixelFormat::kUyvy ? ColorSpace::kYuv : ColorSpace::kRgb;
 }
 
+std::string imageSizeProblem(int width, int height, int camera_width, int camera_height) {
+  if (width == camera_width && height == camera_height) return "";
+  return "image is " + std::to_string(width) + "x" + std::to_string(height) + " px, the calibration is for " +
+         std::to_string(camera_width) + "x" + std::to_string(camera_height);
+}
+
 bool pixelFormatFromEncoding(const std::string& encoding, PixelFormat* format) {
   if (encoding == "rgb8") {
     *format = PixelFormat::kRgb8;

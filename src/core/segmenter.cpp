@@ -96,10 +96,9 @@ void Segmenter::classify(const LutView& lut, const ImageView& image, cv::Mat& la
     throw std::invalid_argument(std::string("the table's color space does not fit ") + encodingName(image.format) +
                                 " images");
   }
-  if (!spans_.empty() && (image.width != width_ || image.height != height_)) {
-    throw std::invalid_argument("image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
-                                " px, the calibration is for " + std::to_string(width_) + "x" +
-                                std::to_string(height_));
+  if (!spans_.empty()) {
+    const std::string size = imageSizeProblem(image.width, image.height, width_, height_);
+    if (!size.empty()) throw std::invalid_argument(size);
   }
   labels.create(image.height, image.width, CV_8UC1);
   const uint8_t* table = lut.table;

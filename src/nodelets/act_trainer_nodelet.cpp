@@ -94,8 +94,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool onSaveLut(FilePath::Request& req, FilePath::Response& res);
   bool onLoadLut(FilePath::Request& req, FilePath::Response& res);
   // A table file: saveLut = prepareSave (the table and ~lut_dir, under the lock) + writeTable (the
-  // file inside ~lut_dir and its I/O, touching the file system only); loadLut = loadPath + readTable (the file I/O
-  // alone) + installTable (under the lock). The services run the I/O parts with a timeout.
+  // file inside ~lut_dir and its I/O: every file system call); loadLut = loadPath + readTable (the
+  // file I/O alone) + installTable (under the lock). The services run the I/O parts with a timeout.
   struct LoadedTable {
     act_color::ColorLut msg;
     core::ColorLut lut;

@@ -279,11 +279,9 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
       }
       // An image no table can classify is refused now, not after waiting ~max_wait for its table.
       std::string problem = ros_conversions::imageMessageProblem(*msg);
-      if (problem.empty() && (msg->width != static_cast<uint32_t>(camera_->width()) ||
-                              msg->height != static_cast<uint32_t>(camera_->height()))) {
-        problem = "image is " + std::to_string(msg->width) + "x" + std::to_string(msg->height) +
-                  " px, the calibration is for " + std::to_string(camera_->width()) + "x" +
-                  std::to_string(camera_->height());
+      if (problem.empty()) {
+        problem = core::imageSizeProblem(static_cast<int>(msg->width), static_cast<int>(msg->height), camera_->width(),
+                                         camera_->height());
       }
       if (!problem.empty()) {
         ++images_;

@@ -89,11 +89,8 @@ bool fromMsg(const act_color::ColorLut& msg, core::ColorLut* lut, std::string* e
     *error = "stamp has " + std::to_string(msg.header.stamp.nsec) + " nanoseconds (at most 999999999)";
     return false;
   }
-  if (msg.revision > core::ActTrainer::kMaxRevision) {
-    *error = "revision " + std::to_string(msg.revision) + " is above " +
-             std::to_string(core::ActTrainer::kMaxRevision) + " (two years of cycles at 30 Hz)";
-    return false;
-  }
+  *error = core::ActTrainer::revisionProblem(msg.revision);
+  if (!error->empty()) return false;
   core::ColorLut out(msg.bits_per_channel, colorSpace(msg));
   if (msg.table.size() != out.size()) {
     *error = "table has " + std::to_string(msg.table.size()) + " cells, expected " + std::to_string(out.size());

@@ -220,6 +220,8 @@ class ActTrainer {
   // The largest revision a saved state may have: cycles are stamped in 32 bits (the removal
   // protection, the kept lights), and 2^31 cycles are two years at 30 Hz.
   static constexpr uint64_t kMaxRevision = uint64_t{1} << 31;
+  // Why a saved state's revision is none (above kMaxRevision); empty when it is one.
+  static std::string revisionProblem(uint64_t revision);
   // Installs a saved state: the table, the clusters it was trained with and its revision, so that
   // training goes on where it stopped. A class whose cluster is not given, or that has no cell in
   // the table, starts at eq. 2-3. Throws std::invalid_argument for sizes that differ, a cluster

@@ -21,6 +21,9 @@ inline size_t bytesPerPixel(PixelFormat format) { return format == PixelFormat::
 // Parses a ROS encoding string; false for anything unsupported.
 bool pixelFormatFromEncoding(const std::string& encoding, PixelFormat* format);
 const char* encodingName(PixelFormat format);
+// Why an image of width x height px cannot be one of a camera calibrated for camera_width x
+// camera_height ("image is ... px, the calibration is for ..."); empty when the sizes agree.
+std::string imageSizeProblem(int width, int height, int camera_width, int camera_height);
 
 // A non-owning view of an image in one of the supported layouts.
 struct ImageView {
