@@ -27,6 +27,22 @@ ClassificationMetrics evaluate(const ActTrainer& trainer, const act_color::sim::
   return m;
 }
 
+// The pixels of `mask` on every n-th row (from row 0), over `reference` pixels.
+double rowsShare(const cv::Mat& mask, int every_nth_row, int reference) {
+  int count = 0;
+  for (int v = 0; v < mask.rows; v += every_nth_row) count += cv::countNonZero(mask.row(v));
+  return static_cast<double>(count) / reference;
+}
+
+// The row step (2-99) whose rows of `mask` hold nearest to `ratio` times `reference` pixels.
+int rowStepFor(const cv::Mat& mask, int reference, double ratio) {
+  int best = 2;
+  for (int n = 3; n < 100; ++n) {
+    if (std::abs(rowsShare(mask, n, reference) - ratio) < std::abs(rowsShare(mask, best, reference) - ratio)) best = n;
+  }
+  return best;
+}
+
 // Number of pixels of each geometric class (eq. 1 not applied).
 std::array<size_t, 256> geometricCounts(const ExpectedClassModel& model, const Pose2D& pose) {
   std::array<size_t, 256> counts{};
@@ -774,16 +790,8 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   const int line_pixels = cv::countNonZero(lines);
   ASSERT_GT(line_pixels, 1000);
   // The row step whose painted hall pixels come nearest to four times the line pixels.
-  auto paintedRatio = [&](int every_nth_row) {
-    int painted = 0;
-    for (int v = 0; v < 580; v += every_nth_row) painted += cv::countNonZero(hall.row(v));
-    return static_cast<double>(painted) / line_pixels;
-  };
-  int some_rows = 2;
-  for (int n = 3; n < 60; ++n) {
-    if (std::abs(paintedRatio(n) - 4.0) < std::abs(paintedRatio(some_rows) - 4.0)) some_rows = n;
-  }
-  ASSERT_NEAR(paintedRatio(some_rows), 4.0, 0.4);
+  const int some_rows = rowStepFor(hall, line_pixels, 4.0);
+  ASSERT_NEAR(rowsShare(hall, some_rows, line_pixels), 4.0, 0.4);
   auto run = [&](uint8_t value, int every_nth_row) {
     const cv::Scalar color(value, value, value);
     cv::Mat frame = clean.rgb.clone();
@@ -806,6 +814,57 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   EXPECT_LT(run(240, some_rows), 0.3);
   EXPECT_GT(run(255, some_rows), 0.9);
   EXPECT_LT(run(255, 1), 0.1);
+}
+
+TEST_F(ActTrainerTest, ACarpetColorTheHallShowsMoreOftenIsTheHalls) {
+  // A frame without noise, each class in one color, and a band of the carpet in a color within xi
+  // sigma of green (2.4's distance keeps it), shown by some rows of the hall too. The carpet's
+  // colors follow the majority (kCarpetEvidenceRatio 1): seen off the field twice as often as in
+  // it, the color is the hall's (the other classes' ratio of 3 kept it green in every cycle); half
+  // as often, it stays green.
+  const Pose2D near_corner{7.5, 4.5, 0.0};
+  const cv::Mat truth = paintFlatFrame(model, near_corner, 1.0, 1).labels;
+  const cv::Vec3b carpet(45, 140, 55), hall_grey(120, 110, 100), band(45, 146, 55);
+  cv::Mat clean(580, 580, CV_8UC3, cv::Scalar(0, 0, 0));
+  cv::Mat in_band(580, 580, CV_8U, cv::Scalar(0)), hall(580, 580, CV_8U, cv::Scalar(0));
+  const PoseTransform t(near_corner);
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      const uint8_t k = truth.at<uint8_t>(v, u);
+      if (k == kGreen) clean.at<cv::Vec3b>(v, u) = carpet;
+      if (k == kWhite) clean.at<cv::Vec3b>(v, u) = cv::Vec3b(235, 235, 230);
+      if (k == kUnknown) clean.at<cv::Vec3b>(v, u) = hall_grey;
+      in_band.at<uint8_t>(v, u) = k == kGreen && v >= 250 && v < 330;
+      hall.at<uint8_t>(v, u) = model.offField(v * 580 + u, t);
+    }
+  }
+  const int band_pixels = cv::countNonZero(in_band);
+  ASSERT_GT(band_pixels, 5000);
+  // The row step whose painted hall pixels come nearest to `ratio` times the band's.
+  auto rowsFor = [&](double ratio) {
+    const int step = rowStepFor(hall, band_pixels, ratio);
+    EXPECT_NEAR(rowsShare(hall, step, band_pixels), ratio, 0.15 * ratio);
+    return step;
+  };
+  auto greenShare = [&](int every_nth_row) {
+    ActTrainer trainer(cal, ActParams());
+    trainer.bootstrap(view(clean), near_corner, 30);
+    const ClassCluster& green = trainer.clusters()[kGreen];
+    const Eigen::Vector3d offset = Eigen::Vector3d(band[0], band[1], band[2]) - green.mean();
+    EXPECT_LT(offset.norm(), ActParams().xi * green.sigma());  // the distance alone would keep it
+    cv::Mat frame = clean.clone();
+    frame.setTo(cv::Scalar(band[0], band[1], band[2]), in_band);
+    for (int v = 0; v < 580; v += every_nth_row) frame.row(v).setTo(cv::Scalar(band[0], band[1], band[2]), hall.row(v));
+    for (int i = 0; i < 100; ++i) trainer.cycle(view(frame), near_corner);
+    int green_cycles = 0;
+    for (int i = 0; i < 100; ++i) {
+      trainer.cycle(view(frame), near_corner);
+      green_cycles += trainer.lut().classOf(band[0], band[1], band[2]) == kGreen;
+    }
+    return green_cycles / 100.0;
+  };
+  EXPECT_LT(greenShare(rowsFor(2.0)), 0.3);
+  EXPECT_GT(greenShare(rowsFor(0.5)), 0.9);
 }
 
 TEST_F(ActTrainerTest, ARobotInFrontOfAGoalAtStartUpDoesNotBecomeTheGoal) {
