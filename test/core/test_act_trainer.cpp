@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <functional>
+#include <map>
 #include <opencv2/imgproc.hpp>
 
 #include "act_color/core/act_trainer.hpp"
@@ -816,55 +817,60 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   EXPECT_LT(run(255, 1), 0.1);
 }
 
-TEST_F(ActTrainerTest, ACarpetColorTheHallShowsMoreOftenIsTheHalls) {
-  // A frame without noise, each class in one color, and a band of the carpet in a color within xi
-  // sigma of green (2.4's distance keeps it), shown by some rows of the hall too. The carpet's
-  // colors follow the majority (kCarpetEvidenceRatio 1): seen off the field twice as often as in
-  // it, the color is the hall's (the other classes' ratio of 3 kept it green in every cycle); half
-  // as often, it stays green.
+TEST_F(ActTrainerTest, ARegionsColorTheHallShowsMoreOftenIsTheHalls) {
+  // A frame without noise, each class in one color; part of a region (a band of the carpet, the
+  // yellow goal) in a color within xi sigma of its class (2.4's distance keeps it), shown by some
+  // rows of the hall too. The regions' colors follow the majority (kRegionEvidenceRatio 1): seen
+  // off the field twice as often as in the region, the color is the hall's (the lines' ratio of 3
+  // kept it in the class in every cycle); half as often, it stays.
   const Pose2D near_corner{7.5, 4.5, 0.0};
   const cv::Mat truth = paintFlatFrame(model, near_corner, 1.0, 1).labels;
-  const cv::Vec3b carpet(45, 140, 55), hall_grey(120, 110, 100), band(45, 146, 55);
-  cv::Mat clean(580, 580, CV_8UC3, cv::Scalar(0, 0, 0));
-  cv::Mat in_band(580, 580, CV_8U, cv::Scalar(0)), hall(580, 580, CV_8U, cv::Scalar(0));
+  const std::map<uint8_t, cv::Vec3b> colors = {{kUnknown, {120, 110, 100}}, {kGreen, {45, 140, 55}},
+                                               {kWhite, {235, 235, 230}},   {kYellow, {225, 200, 35}},
+                                               {kBlue, {35, 70, 205}},      {kBlack, {28, 28, 32}}};
+  cv::Mat clean(580, 580, CV_8UC3, cv::Scalar(0, 0, 0)), hall(580, 580, CV_8U, cv::Scalar(0));
   const PoseTransform t(near_corner);
   for (int v = 0; v < 580; ++v) {
     for (int u = 0; u < 580; ++u) {
-      const uint8_t k = truth.at<uint8_t>(v, u);
-      if (k == kGreen) clean.at<cv::Vec3b>(v, u) = carpet;
-      if (k == kWhite) clean.at<cv::Vec3b>(v, u) = cv::Vec3b(235, 235, 230);
-      if (k == kUnknown) clean.at<cv::Vec3b>(v, u) = hall_grey;
-      in_band.at<uint8_t>(v, u) = k == kGreen && v >= 250 && v < 330;
+      const auto color = colors.find(truth.at<uint8_t>(v, u));
+      if (color != colors.end()) clean.at<cv::Vec3b>(v, u) = color->second;
       hall.at<uint8_t>(v, u) = model.offField(v * 580 + u, t);
     }
   }
-  const int band_pixels = cv::countNonZero(in_band);
-  ASSERT_GT(band_pixels, 5000);
-  // The row step whose painted hall pixels come nearest to `ratio` times the band's.
-  auto rowsFor = [&](double ratio) {
-    const int step = rowStepFor(hall, band_pixels, ratio);
-    EXPECT_NEAR(rowsShare(hall, step, band_pixels), ratio, 0.15 * ratio);
-    return step;
-  };
-  auto greenShare = [&](int every_nth_row) {
-    ActTrainer trainer(cal, ActParams());
-    trainer.bootstrap(view(clean), near_corner, 30);
-    const ClassCluster& green = trainer.clusters()[kGreen];
-    const Eigen::Vector3d offset = Eigen::Vector3d(band[0], band[1], band[2]) - green.mean();
-    EXPECT_LT(offset.norm(), ActParams().xi * green.sigma());  // the distance alone would keep it
-    cv::Mat frame = clean.clone();
-    frame.setTo(cv::Scalar(band[0], band[1], band[2]), in_band);
-    for (int v = 0; v < 580; v += every_nth_row) frame.row(v).setTo(cv::Scalar(band[0], band[1], band[2]), hall.row(v));
-    for (int i = 0; i < 100; ++i) trainer.cycle(view(frame), near_corner);
-    int green_cycles = 0;
-    for (int i = 0; i < 100; ++i) {
-      trainer.cycle(view(frame), near_corner);
-      green_cycles += trainer.lut().classOf(band[0], band[1], band[2]) == kGreen;
-    }
-    return green_cycles / 100.0;
-  };
-  EXPECT_LT(greenShare(rowsFor(2.0)), 0.3);
-  EXPECT_GT(greenShare(rowsFor(0.5)), 0.9);
+  for (const uint8_t k : {kGreen, kYellow}) {
+    SCOPED_TRACE(className(k));
+    cv::Mat part = truth == k;
+    if (k == kGreen) part.rowRange(0, 250).setTo(0), part.rowRange(330, 580).setTo(0);  // a band
+    const int part_pixels = cv::countNonZero(part);
+    ASSERT_GT(part_pixels, 1000);
+    const cv::Vec3b shown = colors.at(k) + cv::Vec3b(0, 6, 0);
+    const cv::Scalar shown_scalar(shown[0], shown[1], shown[2]);
+    // The row step whose painted hall pixels come nearest to `ratio` times the part's.
+    auto rowsFor = [&](double ratio) {
+      const int step = rowStepFor(hall, part_pixels, ratio);
+      EXPECT_NEAR(rowsShare(hall, step, part_pixels), ratio, 0.15 * ratio);
+      return step;
+    };
+    auto classShare = [&](int every_nth_row) {
+      ActTrainer trainer(cal, ActParams());
+      trainer.bootstrap(view(clean), near_corner, 30);
+      const ClassCluster& cluster = trainer.clusters()[k];
+      const Eigen::Vector3d offset = Eigen::Vector3d(shown[0], shown[1], shown[2]) - cluster.mean();
+      EXPECT_LT(offset.norm(), ActParams().xi * cluster.sigma());  // the distance alone would keep it
+      cv::Mat frame = clean.clone();
+      frame.setTo(shown_scalar, part);
+      for (int v = 0; v < 580; v += every_nth_row) frame.row(v).setTo(shown_scalar, hall.row(v));
+      for (int i = 0; i < 100; ++i) trainer.cycle(view(frame), near_corner);
+      int in_class = 0;
+      for (int i = 0; i < 100; ++i) {
+        trainer.cycle(view(frame), near_corner);
+        in_class += trainer.lut().classOf(shown[0], shown[1], shown[2]) == k;
+      }
+      return in_class / 100.0;
+    };
+    EXPECT_LT(classShare(rowsFor(2.0)), 0.3);
+    EXPECT_GT(classShare(rowsFor(0.5)), 0.9);
+  }
 }
 
 TEST_F(ActTrainerTest, ARobotInFrontOfAGoalAtStartUpDoesNotBecomeTheGoal) {
