@@ -85,8 +85,10 @@ struct ActParams {
   // something else than the class (a spot-lit whitish hall floor next to white). A clipped color
   // (a channel at 254 or 255) needs five times the in-field count: a saturated line and a saturated
   // lamp are one color, and after a brightening that clips the lines' cores the hall's clipped
-  // pixels can outnumber them. The other way round, a color seen in the field at least twice as
-  // often as off it is not removed for lying beyond xi sigma (kEvidenceKeepRatio). 0: off.
+  // pixels can outnumber them. The carpet's, the goals' and the ball's colors need only the
+  // majority (at most this ratio, 1: regions sampled all over need no margin). The other way
+  // round, a color seen in the field at least twice as often as off it is not removed for lying
+  // beyond xi sigma (kEvidenceKeepRatio). 0: off.
   double evidence_removal_ratio = 3.0;
   // Where the carpet meets a line the image shows mixed colors (blur, a line narrower than a
   // pixel), and the field model says which side of the boundary each pixel lies on. Along the axis
@@ -267,8 +269,8 @@ class ActTrainer {
   // ActParams::learned_boundary: counts this cycle's pixels near the carpet-line boundary, learns
   // the split from the counts and removes the white cells that lie wholly on the carpet's side.
   void learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
-  // ActParams::evidence_removal_ratio for color c of class k (lower for the ball, higher for a
-  // clipped color).
+  // ActParams::evidence_removal_ratio for color c of class k (at most 1 for the ball, the carpet
+  // and the goals, higher for a clipped color).
   double evidenceRatio(uint8_t k, const uint8_t c[3]) const;
   // The own chassis's colors (chassis_samples_, an anchor of the light model) and their median
   // intensity, robots_train_black's black of this light.
