@@ -217,16 +217,18 @@ RealImageResult evaluateRealImage(const RealImage& image,
           for (const cv::Point& p : whites) white += classOf(p.y * frame.cols + p.x) == core::kWhite;
           fig.white_recall = static_cast<double>(white) / whites.size();
         }
-        size_t green = 0, in_field = 0, black = 0;
+        size_t green = 0, in_field = 0, black = 0, goal = 0;
         for (const int i : carpet) green += classOf(i) == core::kGreen;
         for (const int i : hall) {
           const uint8_t k = classOf(i);
           in_field += k == core::kGreen || k == core::kWhite;
           black += k == core::kBlack;
+          goal += k == core::kYellow || k == core::kBlue;
         }
         fig.green_recall = carpet.empty() ? 0.0 : static_cast<double>(green) / carpet.size();
         fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
         fig.hall_as_black = hall.empty() ? 0.0 : static_cast<double>(black) / hall.size();
+        fig.hall_as_goal = hall.empty() ? 0.0 : static_cast<double>(goal) / hall.size();
         // The labels as the segmentation gives them: the table's, and the ball's image where the cycle
         // saw it (the ball's figures, and the pictures).
         segmenter.classify(lut, view, labels);
@@ -281,11 +283,13 @@ RealImageResult evaluateRealImage(const RealImage& image,
           m.green_recall += figures[f].green_recall;
           m.hall_in_field += figures[f].hall_in_field;
           m.hall_as_black += figures[f].hall_as_black;
+          m.hall_as_goal += figures[f].hall_as_goal;
         }
         m.white_recall /= count;
         m.green_recall /= count;
         m.hall_in_field /= count;
         m.hall_as_black /= count;
+        m.hall_as_goal /= count;
         if (whites.empty()) m.white_recall = -1;
         if (image.ball) {
           // Precision over the frames with ball pixels.
@@ -393,7 +397,8 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
       out << line;
     }
     out << "| variant | mode | white before / after | white back in | green before / after | hall in a field class "
-           "before / after | hall as black before / after |\n|---|---|---|---|---|---|---|\n";
+           "before / after | hall as black before / after | hall as a goal before / after |\n"
+           "|---|---|---|---|---|---|---|---|\n";
     for (size_t n = 0; n < r.rows.size(); ++n) {
       const RealVariantResult& row = r.rows[n];
       // A row of any fixed table's least hall at the white and green recalls given (before, after):
@@ -409,7 +414,7 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
                         white_hall.second, green_hall.first, green_hall.second);
           std::snprintf(white_col, sizeof(white_col), "%.2f / %.2f", white_recall.first, white_recall.second);
         }
-        std::snprintf(line, sizeof(line), "| %s | %s | %s | - | %.2f / %.2f | %.2f / %.2f (%s) | - |\n",
+        std::snprintf(line, sizeof(line), "| %s | %s | %s | - | %.2f / %.2f | %.2f / %.2f (%s) | - | - |\n",
                       row.variant.c_str(), label.c_str(), white_col, green_recall.first, green_recall.second,
                       green_hall.first + std::max(0.0, white_hall.first),
                       green_hall.second + std::max(0.0, white_hall.second), parts);
@@ -427,14 +432,16 @@ std::string formatRealImageReport(const std::vector<RealImageResult>& results) {
           std::snprintf(back, sizeof(back), "%d", row.white_recovery_cycles);
         }
       }
-      std::snprintf(line, sizeof(line), "| %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f |\n",
+      std::snprintf(line, sizeof(line),
+                    "| %s | %s | %s | %s | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f |\n",
                     row.variant.c_str(), row.mode.c_str(), white, back, row.before.green_recall, row.after.green_recall,
                     row.before.hall_in_field, row.after.hall_in_field, row.before.hall_as_black,
-                    row.after.hall_as_black);
+                    row.after.hall_as_black, row.before.hall_as_goal, row.after.hall_as_goal);
       out << line;
       const bool last_of_variant = n + 1 == r.rows.size() || r.rows[n + 1].variant != row.variant;
       if (last_of_variant && row.nubot_before.green_recall >= 0) {
-        std::snprintf(line, sizeof(line), "| %s | NuBot's table | - | - | %.2f / %.2f | %.2f / %.2f (green) | - |\n",
+        std::snprintf(line, sizeof(line),
+                      "| %s | NuBot's table | - | - | %.2f / %.2f | %.2f / %.2f (green) | - | - |\n",
                       row.variant.c_str(), row.nubot_before.green_recall, row.nubot_after.green_recall,
                       row.nubot_before.hall_in_field, row.nubot_after.hall_in_field);
         out << line;
@@ -590,6 +597,7 @@ std::string formatRealImageFrames(const std::vector<RealImageResult>& results) {
       series("green", row.frames, &RealFrameFigures::green_recall);
       series("hall ", row.frames, &RealFrameFigures::hall_in_field);
       series("black", row.frames, &RealFrameFigures::hall_as_black);
+      series("goal ", row.frames, &RealFrameFigures::hall_as_goal);
     }
   }
   return out.str();

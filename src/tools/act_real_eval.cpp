@@ -43,8 +43,9 @@ void printUsage(std::ostream& out) {
          "  --png DIR      each image beside its classes (defaults) as PNGs: the frame before the change\n"
          "                 (NAME_classified.png) and the last frame of each variant (NAME_VARIANT.png)\n"
          "  --set NAME=VALUE  an ActParams parameter of the defaults (repeatable; e.g. seed=2)\n"
-         "  --frames       also every frame's white recall, green recall, hall in a field class and hall\n"
-         "                 as black (after the change from frame 21), per variant and mode\n";
+         "  --frames       also every frame's white recall, green recall, hall in a field class, hall\n"
+         "                 as black and hall as a goal (after the change from frame 21), per variant and\n"
+         "                 mode\n";
 }
 
 // An rgb8 frame beside its labels in the palette, as one PNG; false (and a message) when it

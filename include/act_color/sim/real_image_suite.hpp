@@ -55,6 +55,7 @@ struct RealFrameFigures {
   double green_recall = 0;   // of the pixels expected carpet inside the outer lines, 3 px from other classes
   double hall_in_field = 0;  // of the pixels expected off the carpet (3 px from it) classified green or white
   double hall_as_black = 0;  // of the same pixels, classified black (a robot's class: not counted above)
+  double hall_as_goal = 0;   // of the same pixels, classified yellow or blue (outside the goals' regions)
   // With a marked ball (-1 without): of the pixels 2 px inside the mark, the fraction classified as the
   // ball; of the pixels classified as the ball, the fraction within 3 px of the mark (-1: none); 1 when
   // the trainer reported the ball (CycleStats::ball) with its blob's centroid within 3 px of the mark.
