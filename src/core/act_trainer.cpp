@@ -49,20 +49,18 @@ constexpr size_t kChassisAnchorSamples = 192;
 constexpr double kLightChangeSigmas = 0.4;
 constexpr double kLightChangeMinShift = 5.0;
 
-// The evidence removal ratio for the ball's colors (at most ActParams::evidence_removal_ratio): a
-// color of the ball seen off the field as often as on it gives more false sightings than true.
-constexpr double kBallEvidenceRatio = 1.0;
-// And for the colors of the field's regions, the carpet and the goals: a color the hall shows more
-// often than the region is the hall's (a fixed table's majority). Regions are sampled all over, so
-// their colors need no margin; the lines' few samples of blurred edges do, and so do the robots'
-// (black), whose colors the pose never foresees (black at 1: tuning split 25 class segments down
-// by 0.02 or more in F1, 5 up). After the paper's darkening, which packs the colors four times
-// closer, the real images' hall took green cells a majority would not give it (0.19 / 0.17 / 0.15
-// of the hall in a field class on nubot_2 / nubot_1_bak_bak / nubot_3_new at the other classes'
-// ratio of 3, 0.17 / 0.16 / 0.14 at 1); the goals at 1 moved the tuning split's yellow and blue
-// up by 0.02 or more in 15 segments and down in 3 (session of 2026-12-06 from 06:30,
-// docs/experiments.md).
-constexpr double kRegionEvidenceRatio = 1.0;
+// The evidence removal ratio (at most ActParams::evidence_removal_ratio) of the colors that go by
+// the majority: a color the hall shows more often than the class is the hall's (a fixed table's
+// rule). The ball's: a color of the ball seen off the field as often as on it gives more false
+// sightings than true. The field's regions, the carpet and the goals: sampled all over, their
+// colors need no margin; the lines' few samples of blurred edges do, and so do the robots' (black),
+// whose colors the pose never foresees (black at 1: tuning split 25 class segments down by 0.02 or
+// more in F1, 5 up). After the paper's darkening, which packs the colors four times closer, the
+// real images' hall took green cells a majority would not give it (0.19 / 0.17 / 0.15 of the hall
+// in a field class on nubot_2 / nubot_1_bak_bak / nubot_3_new at the other classes' ratio of 3,
+// 0.17 / 0.16 / 0.14 at 1); the goals at 1 moved the tuning split's yellow and blue up by 0.02 or
+// more in 15 segments and down in 3 (session of 2026-12-06 from 06:30, docs/experiments.md).
+constexpr double kMajorityEvidenceRatio = 1.0;
 
 // A channel at or above this value is clipped. A saturated line and a saturated window or lamp are
 // the same color: a clipped color is removed on the evidence rule (and kept from being added again)
@@ -609,10 +607,11 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
 }
 
 double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
-  if (k == kOrange) return std::min(params_.evidence_removal_ratio, kBallEvidenceRatio);
+  if (k == kOrange) return std::min(params_.evidence_removal_ratio, kMajorityEvidenceRatio);
   if (std::max({c[0], c[1], c[2]}) >= kClippedValue)
     return std::max(params_.evidence_removal_ratio, kClippedEvidenceRatio);
-  if (k == kGreen || k == kYellow || k == kBlue) return std::min(params_.evidence_removal_ratio, kRegionEvidenceRatio);
+  if (k == kGreen || k == kYellow || k == kBlue)
+    return std::min(params_.evidence_removal_ratio, kMajorityEvidenceRatio);
   return params_.evidence_removal_ratio;
 }
 

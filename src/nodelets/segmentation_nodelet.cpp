@@ -75,6 +75,8 @@ class SegmentationNodelet : public nodelet::Nodelet {
   double process(const sensor_msgs::ImageConstPtr& image, const act_color::ColorLutConstPtr& lut,
                  const std::optional<BallSighting>& ball);
   void record(TableUsed table, double classify_ms, double latency_ms);
+  // An image not classified (the lock held): counted, its reason kept for the diagnostics.
+  void countRejected(const std::string& why);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
 
   ros::NodeHandle nh_, pnh_;
@@ -285,9 +287,7 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
       }
       if (!problem.empty()) {
         ++images_;
-        ++rejected_;
-        last_error_ = problem;
-        record(TableUsed::kRejected, 0.0, -1.0);
+        countRejected(problem);
         ACT_WALL_THROTTLE(
             5.0, NODELET_ERROR("image stamped %.3f not classified: %s", msg->header.stamp.toSec(), problem.c_str()));
         return;
@@ -419,13 +419,17 @@ void SegmentationNodelet::flush() {
       record(used, classify_ms, (ros::Time::now() - image->header.stamp).toSec() * 1000.0);
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
-      ++rejected_;
-      last_error_ = e.what();
-      record(TableUsed::kRejected, 0.0, -1.0);
+      countRejected(e.what());
       ACT_WALL_THROTTLE(5.0,
                         NODELET_ERROR("image stamped %.3f not classified: %s", image->header.stamp.toSec(), e.what()));
     }
   }
+}
+
+void SegmentationNodelet::countRejected(const std::string& why) {
+  ++rejected_;
+  last_error_ = why;
+  record(TableUsed::kRejected, 0.0, -1.0);
 }
 
 void SegmentationNodelet::record(TableUsed table, double classify_ms, double latency_ms) {

@@ -15,10 +15,14 @@ core::ColorSpace colorSpace(const act_color::ColorLut& msg) {
 }  // namespace
 
 std::string imageLayoutProblem(const sensor_msgs::Image& image, size_t bytes_per_pixel) {
-  std::ostringstream s;
   const uint64_t min_step = static_cast<uint64_t>(bytes_per_pixel) * image.width;
   const uint64_t min_size = static_cast<uint64_t>(image.step) * image.height;
-  if (image.width == 0 || image.height == 0) {
+  const bool empty = image.width == 0 || image.height == 0;
+  // Checked for every image (twice in the segmentation: on arrival and when classified): no
+  // stream is built for a good one.
+  if (!empty && image.step >= min_step && image.data.size() >= min_size) return "";
+  std::ostringstream s;
+  if (empty) {
     s << "empty image (" << image.width << "x" << image.height << ")";
   } else if (image.step < min_step) {
     s << "step " << image.step << " is less than width " << image.width << " * " << bytes_per_pixel

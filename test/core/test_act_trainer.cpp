@@ -820,7 +820,7 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
 TEST_F(ActTrainerTest, ARegionsColorTheHallShowsMoreOftenIsTheHalls) {
   // A frame without noise, each class in one color; part of a region (a band of the carpet, the
   // yellow goal) in a color within xi sigma of its class (2.4's distance keeps it), shown by some
-  // rows of the hall too. The regions' colors follow the majority (kRegionEvidenceRatio 1): seen
+  // rows of the hall too. The regions' colors follow the majority (kMajorityEvidenceRatio 1): seen
   // off the field twice as often as in the region, the color is the hall's (the lines' ratio of 3
   // kept it in the class in every cycle); half as often, it stays.
   const Pose2D near_corner{7.5, 4.5, 0.0};

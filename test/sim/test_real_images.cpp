@@ -43,7 +43,7 @@ void expectHolds(const sim::RealImageResult& r) {
     // 0.08 on nubot_1_bak_bak, 0.10 and 0.04 before robots_train_black's carpet spread).
     EXPECT_LE(row.before.hall_as_black, 0.15) << row.variant;
     // Nor do the goals, after any change (outside the goals' own regions): since their colors go
-    // by the majority of the evidence (kRegionEvidenceRatio) at most 0.06 on nubot_1_bak_bak and
+    // by the majority of the evidence (kMajorityEvidenceRatio) at most 0.06 on nubot_1_bak_bak and
     // 0.05 on nubot_1; at the lines' ratio of 3, 0.12 on nubot_1_bak_bak after the darkening.
     if (row.mode == "defaults") {
       EXPECT_LE(row.after.hall_as_goal, 0.08) << row.variant;
