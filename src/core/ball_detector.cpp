@@ -5,6 +5,8 @@
 #include <cstring>
 #include <limits>
 
+#include "act_color/core/light_model.hpp"
+
 namespace act_color {
 namespace core {
 namespace {
@@ -24,6 +26,15 @@ constexpr double kMaxAreaFactor = 2.5;
 // least kGrowMinRadius units (a sphere's shading spans a range of intensities).
 constexpr double kGrowSpreads = 3.0;
 constexpr double kGrowMinRadius = 30.0;
+// A sphere's shading scales its color. From grid points of one color (their spread within
+// kGrowMinRadius / kGrowSpreads) a blob also grows through the colors within kGrowMinRadius of that
+// color scaled by kShadeLow to kShadeHigh (about LightModel::pivot: black, or YUV's grey for its
+// chroma). Within the radius alone, a far pink ball of 36 px grew from its one grid point to its
+// lit middle row, 6-9 px, and was never seeded (tuning scene 47: its shading runs from 0.85 to 1.4
+// times that point's color). Grid points of mixed colors (a ball beside a grey robot) define no
+// such line: grown along it, their blob took in the grey (tuning scene 33).
+constexpr double kShadeLow = 0.5;
+constexpr double kShadeHigh = 2.0;
 // Blobs looked at per cycle at most (those with a point of the ball's class first, then the
 // largest). 8 left a far ball of one or two grid points behind specks of noise in most cycles
 // (tuning split: 26 -> 27 of 44 scenes with ball recall and precision both >= 0.80 at 16; 32 gave
@@ -392,8 +403,19 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
   }
   const double seed_spread = std::sqrt(seed_sq / std::max<size_t>(1, seeds.size() - 1));
   const double grow_radius = std::max(kGrowMinRadius, kGrowSpreads * seed_spread);
-  // window_: -1 not looked at, 0 looked at and not in the blob, 1 in the blob.
   const double grow_radius_sq = grow_radius * grow_radius;
+  const bool one_color = kGrowSpreads * seed_spread <= kGrowMinRadius;
+  const Eigen::Vector3d pivot = LightModel::pivot(lut.colorSpace());
+  const Eigen::Vector3d shade_axis = seed_mean - pivot;
+  const double shade_axis_sq = std::max(shade_axis.squaredNorm(), 1.0);
+  auto nearSeedColor = [&](const Eigen::Vector3d& color) {
+    if ((color - seed_mean).squaredNorm() <= grow_radius_sq) return true;
+    if (!one_color) return false;
+    const double scale = (color - pivot).dot(shade_axis) / shade_axis_sq;
+    return scale >= kShadeLow && scale <= kShadeHigh &&
+           (color - pivot - scale * shade_axis).squaredNorm() <= grow_radius_sq;
+  };
+  // window_: -1 not looked at, 0 looked at and not in the blob, 1 in the blob.
   auto look = [&](uint32_t pixel, int u, int v) {
     int8_t& mark = window_[pixel];
     if (mark >= 0) return false;
@@ -403,7 +425,7 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
     image.color(u, v, c);
     const uint8_t k = classOf(lut, known, c);
     if (!ballCandidate(k)) return false;
-    if ((Eigen::Vector3d(c[0], c[1], c[2]) - seed_mean).squaredNorm() > grow_radius_sq) return false;
+    if (!nearSeedColor(Eigen::Vector3d(c[0], c[1], c[2]))) return false;
     mark = 1;
     if (k == kOrange) ++blob->ball_pixels;
     return true;

@@ -252,6 +252,17 @@ TEST(BallTraining, AFarBallAmongSpecksOfNoiseIsSeenInEveryCycle) {
   EXPECT_GE(r.sightings * 3, r.frames_in_view * 2) << r.sightings << " of " << r.frames_in_view;
 }
 
+TEST(BallTraining, AFarShadedBallGrowsWhole) {
+  // Tuning scene 47: a pink ball 7.4 m away, 36 px, one grid point. Its shading runs from 0.85 to
+  // 1.4 times that point's color; grown within 30 units of it, its blob was the lit middle row
+  // (6-9 px, a third of a ball's area) and the ball was never seeded (recall 0, no sighting).
+  const sim::BallFigures r = ballWithDefaults(47);
+  ASSERT_TRUE(r.ball_in_scene);
+  EXPECT_GE(r.recall(), 0.8);
+  EXPECT_GE(r.sightings * 10, r.frames_in_view * 9) << r.sightings << " of " << r.frames_in_view;
+  EXPECT_EQ(r.position_ok, r.sightings);
+}
+
 TEST(BallTraining, AMarkerOfItsColorDoesNotTakeTheBallsPlace) {
   // Tuning scene 57: robots wearing markers of the pink ball's color. The sighting went to the blob
   // with most pixels of the ball's class, often a marker: 12 of 21 sightings where the ball is.
