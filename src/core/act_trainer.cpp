@@ -607,11 +607,11 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
 }
 
 double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
-  if (k == kOrange) return std::min(params_.evidence_removal_ratio, kMajorityEvidenceRatio);
+  const double majority = std::min(params_.evidence_removal_ratio, kMajorityEvidenceRatio);
+  if (k == kOrange) return majority;  // clipped or not
   if (std::max({c[0], c[1], c[2]}) >= kClippedValue)
     return std::max(params_.evidence_removal_ratio, kClippedEvidenceRatio);
-  if (k == kGreen || k == kYellow || k == kBlue)
-    return std::min(params_.evidence_removal_ratio, kMajorityEvidenceRatio);
+  if (k == kGreen || k == kYellow || k == kBlue) return majority;
   return params_.evidence_removal_ratio;
 }
 
@@ -682,9 +682,9 @@ void ActTrainer::measureCarpetShade() {
   carpet_shaded_ = false;
   if (!carpetMeasurable() || !clusters_[kGreen].trained()) return;
   const ColorSpace space = lut_.colorSpace();
-  const Eigen::Vector3d pivot = LightModel::pivot(space);
-  hue_axis_ = (clusters_[kGreen].mean() - pivot).normalized();
-  const Eigen::Vector3f pivot_f = pivot.cast<float>(), axis = hue_axis_.cast<float>();
+  carpet_hue_ = LightModel::shadeLine(clusters_[kGreen].mean(), space);
+  const Eigen::Vector3d& hue_axis = carpet_hue_.axis;
+  const Eigen::Vector3f pivot_f = carpet_hue_.pivot.cast<float>(), axis = hue_axis.cast<float>();
   const size_t n = carpet_samples_.size();
   shade_along_.clear();
   for (const Eigen::Vector3f& c : carpet_samples_) shade_along_.push_back((c - pivot_f).dot(axis));
@@ -701,32 +701,26 @@ void ActTrainer::measureCarpetShade() {
     const Eigen::Vector3f d = carpet_samples_[i] - pivot_f;
     carpet_values_.push_back((d - shade_along_[i] * axis).norm());
   }
-  shade_tolerance_ =
+  carpet_hue_.tolerance =
       kShadedCarpetHueSpreads * std::max<double>(valueOfRank(carpet_values_, n * 3 / 4), params_.sigma_min);
   // Towards the pivot the line nears the greys (a robot's colors): a point of it lies farther from
-  // them than the tolerance only beyond shade_above_ along it, or a grey would pass for the carpet.
+  // them than the tolerance only beyond `from` along it, or a grey would pass for the carpet.
   const double grey_distance = space == ColorSpace::kYuv
-                                   ? hue_axis_.tail<2>().norm()
-                                   : (hue_axis_ - Eigen::Vector3d::Constant(hue_axis_.mean())).norm();
-  shade_above_ = shade_tolerance_ / grey_distance;
+                                   ? hue_axis.tail<2>().norm()
+                                   : (hue_axis - Eigen::Vector3d::Constant(hue_axis.mean())).norm();
+  carpet_hue_.from = carpet_hue_.tolerance / grey_distance;
   carpet_values_ = shade_along_;
   for (float& t : carpet_values_) t = std::abs(t - static_cast<float>(middle));
   constexpr double kNormalSigmaOverMedianDeviation = 1.4826;
   const double spread_along =
       std::max(kNormalSigmaOverMedianDeviation * valueOfRank(carpet_values_, n / 2), params_.sigma_min);
-  shade_below_ = middle - params_.zeta * spread_along;
+  carpet_hue_.to = middle - params_.zeta * spread_along;
   size_t shaded = 0;
-  for (const Eigen::Vector3f& c : carpet_samples_) shaded += carpetHue(c.cast<double>());
+  for (const Eigen::Vector3f& c : carpet_samples_) shaded += carpet_hue_.contains(c.cast<double>());
   carpet_shaded_ = shaded > kShadedCarpetShare * n;
 }
 
-bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const { return carpet_shaded_ && carpetHue(c); }
-
-bool ActTrainer::carpetHue(const Eigen::Vector3d& c) const {
-  const Eigen::Vector3d d = c - LightModel::pivot(lut_.colorSpace());
-  const double t = d.dot(hue_axis_);
-  return t < shade_below_ && t > shade_above_ && (d - t * hue_axis_).norm() <= shade_tolerance_;
-}
+bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const { return carpet_shaded_ && carpet_hue_.contains(c); }
 
 double ActTrainer::intensity(const Eigen::Vector3d& c) const {
   return lut_.colorSpace() == ColorSpace::kYuv ? 3.0 * c[0] : c.sum();

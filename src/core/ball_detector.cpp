@@ -405,15 +405,13 @@ void BallDetector::measure(const ExpectedClassModel& model, const ImageView& ima
   const double grow_radius = std::max(kGrowMinRadius, kGrowSpreads * seed_spread);
   const double grow_radius_sq = grow_radius * grow_radius;
   const bool one_color = kGrowSpreads * seed_spread <= kGrowMinRadius;
-  const Eigen::Vector3d pivot = LightModel::pivot(lut.colorSpace());
-  const Eigen::Vector3d shade_axis = seed_mean - pivot;
-  const double shade_axis_sq = std::max(shade_axis.squaredNorm(), 1.0);
+  ShadeLine shade = LightModel::shadeLine(seed_mean, lut.colorSpace());
+  const double seed_position = shade.position(seed_mean);
+  shade.from = kShadeLow * seed_position;
+  shade.to = kShadeHigh * seed_position;
+  shade.tolerance = grow_radius;
   auto nearSeedColor = [&](const Eigen::Vector3d& color) {
-    if ((color - seed_mean).squaredNorm() <= grow_radius_sq) return true;
-    if (!one_color) return false;
-    const double scale = (color - pivot).dot(shade_axis) / shade_axis_sq;
-    return scale >= kShadeLow && scale <= kShadeHigh &&
-           (color - pivot - scale * shade_axis).squaredNorm() <= grow_radius_sq;
+    return (color - seed_mean).squaredNorm() <= grow_radius_sq || (one_color && shade.contains(color));
   };
   // window_: -1 not looked at, 0 looked at and not in the blob, 1 in the blob.
   auto look = [&](uint32_t pixel, int u, int v) {

@@ -284,12 +284,10 @@ class ActTrainer {
   // robots_train_black's shade of the carpet: whether a part of the field lies in a shadow this
   // cycle (carpet_shaded_), from the carpet samples that are dark colors of the carpet's own hue.
   void measureCarpetShade();
-  // A color of the carpet's hue in a shadow: within kShadedCarpetHueSpreads of the carpet's spread
-  // across the line from black (LightModel::pivot) through green's mean, where the line lies
-  // farther than that from the greys, and below the carpet's median along it by more than zeta
-  // times its spread there.
-  bool carpetHue(const Eigen::Vector3d& c) const;
-  // Such a color while carpet_shaded_: carpet in a shadow, not a robot.
+  // While carpet_shaded_, a color of the carpet's hue in a shadow (carpet_hue_: within
+  // kShadedCarpetHueSpreads of the carpet's spread across the line from black through green's mean,
+  // where the line lies farther than that from the greys, and below the carpet's median along it by
+  // more than zeta times its spread there): carpet in a shadow, not a robot.
   bool shadedCarpet(const Eigen::Vector3d& c) const;
   // False for a color of a goal sample (k yellow or blue) that is no goal's color.
   bool goalColor(uint8_t k, const Eigen::Vector3f& c) const;
@@ -379,15 +377,12 @@ class ActTrainer {
   // scratch of its measurements (the samples' distances, one channel of their colors).
   double carpet_spread_ = -1;
   std::vector<float> carpet_values_;
-  // measureCarpetShade: the carpet's hue (the line from LightModel::pivot along the unit vector
-  // hue_axis_), the distance from it within which a color has that hue (kShadedCarpetHueSpreads
-  // times the upper quartile of the carpet samples' distances from it), the positions along it
-  // between which such a color is in a shadow, whether more than kShadedCarpetShare of the carpet
-  // samples are, and the scratch of their positions along it.
-  Eigen::Vector3d hue_axis_ = Eigen::Vector3d::Zero();
-  double shade_tolerance_ = 0;
-  double shade_above_ = 0;
-  double shade_below_ = 0;
+  // measureCarpetShade: the carpet's hue (the shade line through green's mean), the distance from
+  // it within which a color has that hue (kShadedCarpetHueSpreads times the upper quartile of the
+  // carpet samples' distances from it), the positions along it between which such a color is in a
+  // shadow, whether more than kShadedCarpetShare of the carpet samples are, and the scratch of
+  // their positions along it.
+  ShadeLine carpet_hue_;
   bool carpet_shaded_ = false;
   std::vector<float> shade_along_;
   double goal_min_chroma_ = 0;  // goalColor's least chroma, of this cycle's carpet (measureCarpetColor)

@@ -16,6 +16,22 @@ namespace core {
 // The anchors are first moved onto the curve y = a + b 255 (x / 255)^gamma that fits them (one
 // misleading anchor left out), which the function then follows; when no such curve fits, the
 // function is linear between the anchors as seen. Beyond them it continues the nearest segment.
+// The colors of one surface under more or less light: the line from LightModel::pivot (black, or
+// YUV's grey for the chroma) through one of its colors; a color is on it between the positions
+// `from` and `to` along the unit `axis` and within `tolerance` of the line (the carpet in a
+// shadow, a ball's shaded side and highlight).
+struct ShadeLine {
+  Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+  double from = 0, to = 0, tolerance = 0;
+  double position(const Eigen::Vector3d& c) const { return (c - pivot).dot(axis); }
+  bool contains(const Eigen::Vector3d& c) const {
+    const Eigen::Vector3d d = c - pivot;
+    const double t = d.dot(axis);
+    return t > from && t < to && (d - t * axis).norm() <= tolerance;
+  }
+};
+
 class LightModel {
  public:
   // f(x) for x = 0 ... 256 (the upper end of the last color value), per channel.
@@ -39,6 +55,14 @@ class LightModel {
   // The value about which a gain scales a channel: 0, or 128 for the chroma channels of YUV.
   static Eigen::Vector3d pivot(ColorSpace space) {
     return space == ColorSpace::kYuv ? Eigen::Vector3d(0, 128, 128) : Eigen::Vector3d::Zero();
+  }
+  // The shade line through `color` (its position along the line: the distance from the pivot);
+  // from, to and tolerance 0 (it contains no color until they are set).
+  static ShadeLine shadeLine(const Eigen::Vector3d& color, ColorSpace space) {
+    ShadeLine line;
+    line.pivot = pivot(space);
+    line.axis = (color - line.pivot).normalized();
+    return line;
   }
 
   // The map from the reference to this cycle's anchors. False when the anchors do not describe a
