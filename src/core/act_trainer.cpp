@@ -142,6 +142,23 @@ T valueOfRank(std::vector<T>& values, size_t rank) {
   return *at;
 }
 
+// Per channel, the value of the given rank (0: the smallest) among colors whose channels are byte
+// values: counted in one pass (valueOfRank's selection, once per channel, was 3% of a cycle).
+Eigen::Vector3f channelValuesOfRank(const std::vector<Eigen::Vector3f>& colors, size_t rank) {
+  std::array<std::array<uint32_t, 256>, 3> counts{};
+  for (const Eigen::Vector3f& c : colors) {
+    for (int ch = 0; ch < 3; ++ch) ++counts[ch][static_cast<uint8_t>(c[ch])];
+  }
+  Eigen::Vector3f out;
+  for (int ch = 0; ch < 3; ++ch) {
+    size_t below = 0;
+    int value = 0;
+    while (value < 255 && below + counts[ch][value] <= rank) below += counts[ch][value++];
+    out[ch] = static_cast<float>(value);
+  }
+  return out;
+}
+
 }  // namespace
 
 void ActParams::validate() const {
@@ -662,12 +679,7 @@ void ActTrainer::measureCarpetColor() {
   // their grey (fresh seed 2026: yellow F1 0.10, a fixed table's 0.99).
   goal_min_chroma_ = 0;
   if (!carpetMeasurable()) return;
-  Eigen::Vector3f median;
-  for (int ch = 0; ch < 3; ++ch) {
-    carpet_values_.clear();
-    for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back(c[ch]);
-    median[ch] = valueOfRank(carpet_values_, carpet_values_.size() / 2);
-  }
+  const Eigen::Vector3f median = channelValuesOfRank(carpet_samples_, carpet_samples_.size() / 2);
   goal_min_chroma_ = kGoalMinChromaOfCarpet * chroma(median, lut_.colorSpace());
 }
 
@@ -721,10 +733,6 @@ void ActTrainer::measureCarpetShade() {
 }
 
 bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const { return carpet_shaded_ && carpet_hue_.contains(c); }
-
-double ActTrainer::intensity(const Eigen::Vector3d& c) const {
-  return lut_.colorSpace() == ColorSpace::kYuv ? 3.0 * c[0] : c.sum();
-}
 
 double ActTrainer::darkLimit() const {
   // 80% of the carpet's intensity in the light before the first change, as a position between the

@@ -309,7 +309,9 @@ class ActTrainer {
   double darkLimit() const;
   // The intensity darkLimit() is measured in: the sum of the channels in RGB, 3 Y in YUV (where the
   // sum would add U + V, about 256 for every grey: the own chassis as bright as the carpet).
-  double intensity(const Eigen::Vector3d& c) const;
+  double intensity(const Eigen::Vector3d& c) const {
+    return lut_.colorSpace() == ColorSpace::kYuv ? 3.0 * c[0] : c.sum();
+  }
   // The ball stage (ActParams::ball_training), after 2.3; needs sector_safe_range_ of the pose.
   void trainBall(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
 
