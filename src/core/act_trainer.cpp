@@ -1011,7 +1011,7 @@ void ActTrainer::measureChassis(const ImageView& image) {
   for (const uint32_t i : chassis_pixels_) {
     uint8_t c[3];
     image.color(static_cast<int>(i % width), static_cast<int>(i / width), c);
-    chassis_samples_.emplace_back(c[0], c[1], c[2]);
+    chassis_samples_.push_back(Eigen::Vector3f(c[0], c[1], c[2]));
     values.push_back(intensity(Eigen::Vector3d(c[0], c[1], c[2])));
   }
   chassis_intensity_ = valueOfRank(values, values.size() / 2);
@@ -1116,8 +1116,9 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
     if (expected_k == kUnknown || expected_k >= kNumClasses) return;
     uint8_t c[3];
     image.color(p.u, p.v, c);
-    if (expected_k == kGreen) carpet_samples_.emplace_back(c[0], c[1], c[2]);
-    samples_[trainedClass(expected_k, c, dark_limit)].emplace_back(c[0], c[1], c[2]);
+    const Eigen::Vector3f color(c[0], c[1], c[2]);
+    if (expected_k == kGreen) carpet_samples_.push_back(color);
+    samples_[trainedClass(expected_k, c, dark_limit)].push_back(color);
   });
   if (params_.light_compensation) {
     // A closer look before the whole table moves: carpet and lines of this frame at the stride of
