@@ -412,6 +412,29 @@ ClusterParams ActTrainer::clusterParams() const {
   return p;
 }
 
+// Called for every sample and its neighbourhood in 2.3: defined before their use, inline.
+inline bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const {
+  return carpet_shaded_ && carpet_hue_.contains(c);
+}
+
+inline bool ActTrainer::nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const {
+  // The carpet's hue decides for a shaded carpet color: its chroma is a fraction of the carpet's,
+  // nearer to a grey's or a shaded goal's.
+  if (k == kGreen && shadedCarpet(color)) return false;
+  for (const MeanBoundary& b : mean_boundaries_[k]) {
+    if (b.normal.dot(color) < b.offset) return true;
+  }
+  return false;
+}
+
+inline bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const {
+  if (current == kUnknown || current == k || current >= kNumClasses) return false;
+  const ClassCluster& other = clusters_[current];
+  if (!other.trained()) return false;
+  const ClassCluster& own = clusters_[k];
+  return (other.mean() - color).norm() / other.sigma() <= (own.mean() - color).norm() / own.sigma();
+}
+
 uint32_t ActTrainer::addColor(const uint8_t c[3], uint8_t k, bool ball_sighting) {
   if (absent_[k]) return 0;
   const ClassCluster& cluster = clusters_[k];
@@ -632,7 +655,7 @@ double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
   return params_.evidence_removal_ratio;
 }
 
-uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3], double dark_limit) const {
+inline uint8_t ActTrainer::trainedClass(uint8_t k, const uint8_t c[3], double dark_limit) const {
   // Robots stand on the carpet and in front of the goals: there, a robot's color is what the pose
   // cannot foresee.
   if ((k != kGreen && k != kYellow && k != kBlue) || !params_.robots_train_black) return k;
@@ -666,8 +689,9 @@ void ActTrainer::measureCarpetSpread() {
   if (!carpetMeasurable() || !clusters_[kGreen].trained()) return;
   carpet_values_.clear();
   const Eigen::Vector3f mean = clusters_[kGreen].mean().cast<float>();
-  for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back((c - mean).norm());
-  const double upper_quartile = valueOfRank(carpet_values_, carpet_values_.size() * 3 / 4);
+  // Ranked as squared distances: the root of the one chosen is that distance.
+  for (const Eigen::Vector3f& c : carpet_samples_) carpet_values_.push_back((c - mean).squaredNorm());
+  const double upper_quartile = std::sqrt(valueOfRank(carpet_values_, carpet_values_.size() * 3 / 4));
   constexpr double kRmsOverUpperQuartileDistance = 0.854;
   carpet_spread_ = std::max(kRmsOverUpperQuartileDistance * upper_quartile, params_.sigma_min);
 }
@@ -731,8 +755,6 @@ void ActTrainer::measureCarpetShade() {
   for (const Eigen::Vector3f& c : carpet_samples_) shaded += carpet_hue_.contains(c.cast<double>());
   carpet_shaded_ = shaded > kShadedCarpetShare * n;
 }
-
-bool ActTrainer::shadedCarpet(const Eigen::Vector3d& c) const { return carpet_shaded_ && carpet_hue_.contains(c); }
 
 double ActTrainer::darkLimit() const {
   // 80% of the carpet's intensity in the light before the first change, as a position between the
@@ -799,24 +821,6 @@ void ActTrainer::markAbsentGoals(CycleStats& stats) {
 
 bool ActTrainer::goalColor(uint8_t k, const Eigen::Vector3f& c) const {
   return (k != kYellow && k != kBlue) || chroma(c, lut_.colorSpace()) >= goal_min_chroma_;
-}
-
-bool ActTrainer::nearerToOtherMean(const Eigen::Vector3d& color, uint8_t k) const {
-  // The carpet's hue decides for a shaded carpet color: its chroma is a fraction of the carpet's,
-  // nearer to a grey's or a shaded goal's.
-  if (k == kGreen && shadedCarpet(color)) return false;
-  for (const MeanBoundary& b : mean_boundaries_[k]) {
-    if (b.normal.dot(color) < b.offset) return true;
-  }
-  return false;
-}
-
-bool ActTrainer::claimedByOtherClass(const Eigen::Vector3d& color, uint8_t current, uint8_t k) const {
-  if (current == kUnknown || current == k || current >= kNumClasses) return false;
-  const ClassCluster& other = clusters_[current];
-  if (!other.trained()) return false;
-  const ClassCluster& own = clusters_[k];
-  return (other.mean() - color).norm() / other.sigma() <= (own.mean() - color).norm() / own.sigma();
 }
 
 void ActTrainer::applyLightChange(const LightModel::Map& map) {
