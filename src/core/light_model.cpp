@@ -175,23 +175,27 @@ void LightModel::observe(const std::vector<Eigen::Vector3f>& green, const std::v
     const auto& s = *samples[a];
     if (s.size() < kMinSamples[a]) continue;
     q.assign(kLevels[a].size(), Eigen::Vector3d::Zero());
-    // Quantiles from a histogram per channel (colors are 8-bit): linear in the samples, no sort.
+    // Quantiles from a histogram per channel (colors are 8-bit): linear in the samples, no sort;
+    // the three channels counted in one pass.
+    for (auto& h : histograms_) h.fill(0);
+    for (const auto& color : s) {
+      for (int c = 0; c < 3; ++c) ++histograms_[c][static_cast<uint8_t>(color[c])];
+    }
     for (int c = 0; c < 3; ++c) {
-      histogram_.fill(0);
-      for (const auto& color : s) ++histogram_[static_cast<uint8_t>(color[c])];
+      const std::array<uint32_t, 256>& histogram = histograms_[c];
       uint32_t below = 0;  // samples in the bins before `bin`
       int bin = 0;
       for (size_t l = 0; l < kLevels[a].size(); ++l) {
         // The sample of rank pos (0-based, fractional) among the sorted values.
         const double pos = kLevels[a][l] * static_cast<double>(s.size() - 1);
-        while (below + histogram_[bin] <= pos) below += histogram_[bin++];
+        while (below + histogram[bin] <= pos) below += histogram[bin++];
         const double rank_lo = std::floor(pos);
         const double value_lo = bin;
         // The next rank may lie in a later bin.
         double value_hi = value_lo;
-        if (rank_lo + 1 < s.size() && below + histogram_[bin] <= rank_lo + 1) {
+        if (rank_lo + 1 < s.size() && below + histogram[bin] <= rank_lo + 1) {
           int next = bin + 1;
-          while (next < 255 && histogram_[next] == 0) ++next;
+          while (next < 255 && histogram[next] == 0) ++next;
           value_hi = next;
         }
         q[l][c] = value_lo + (pos - rank_lo) * (value_hi - value_lo);

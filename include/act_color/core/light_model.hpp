@@ -90,7 +90,7 @@ class LightModel {
   };
   Anchors current_, reference_;
   bool has_reference_ = false;
-  std::array<uint32_t, 256> histogram_{};  // scratch
+  std::array<std::array<uint32_t, 256>, 3> histograms_{};  // scratch, per channel
 };
 
 }  // namespace core
