@@ -1389,8 +1389,6 @@ void ActTrainer::selectRemovalCandidates(size_t start) {
   robot_sectors_.fill(kRobotUnknown);
   // The samples that may be off the field: in each sector of bearings, a prefix of its list
   // (farthest first); the rest lie on the carpet.
-  candidates_.clear();
-  candidate_sectors_.clear();
   for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
     const double safe_range = sector_safe_range_[static_cast<size_t>(sector)];
     const auto first = samples.samples.begin() + samples.sector_begin[sector];
@@ -1398,11 +1396,11 @@ void ActTrainer::selectRemovalCandidates(size_t start) {
     const auto on_carpet = std::partition_point(first, last, [&](const RemovalSample& sample) {
       return ExpectedClassModel::mayBeOffField(sample.range_m, safe_range);
     });
-    candidates_.insert(candidates_.end(), first, on_carpet);
-    candidate_sectors_.resize(candidates_.size(), static_cast<uint8_t>(sector));
     const auto band_end = std::partition_point(
         on_carpet, last, [&](const RemovalSample& sample) { return sample.range_m * robot_reach_ >= safe_range; });
     const RemovalSample* data = samples.samples.data();
+    candidate_spans_[static_cast<size_t>(sector)] = {data + (first - samples.samples.begin()),
+                                                     data + (on_carpet - samples.samples.begin())};
     robot_bands_[static_cast<size_t>(sector)] = {data + (on_carpet - samples.samples.begin()),
                                                  data + (band_end - samples.samples.begin())};
   }
@@ -1442,56 +1440,58 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
     remove_radius_sq[k] = static_cast<float>(radius * radius);
   }
   // The samples lie far apart in memory: their ray and pixel are fetched some samples ahead.
-  constexpr size_t kAhead = 16;
-  const size_t candidates = candidates_.size();
-  for (size_t j = 0; j < candidates; ++j) {
-    if (j + kAhead < candidates) {
-      const RemovalSample& ahead = candidates_[j + kAhead];
-      model_.prefetchRay(ahead.pixel);
-      __builtin_prefetch(pixels.address(ahead.pixel, ahead.u, ahead.v));
-    }
-    // The color first: most colors seen off the field are mapped to no class, and then whether
-    // the pixel really is off the field (a ray cast) does not matter.
-    const RemovalSample& sample = candidates_[j];
-    uint8_t c[3];
-    pixels.color(sample.pixel, sample.u, sample.v, c);
-    const uint32_t cell = lut_.index(c[0], c[1], c[2]);
-    if (!mapped(cell)) continue;  // the bitmap fits the L1 cache, the table does not
-    const uint8_t k = lut_.at(cell);
-    if (k >= kNumClasses) continue;
-    if (k == kBlack && maybeRobot(candidate_sectors_[j], sample.range_m, pixels)) continue;
-    if (!model_.offField(sample.pixel, transform)) continue;
-    ++stats.remove_candidates;
-    // The ball is one small object whose colors are never expected from the pose: one sighting off
-    // the field counts.
-    const bool ball = k == kOrange;
-    if (params_.evidence_removal_ratio > 0) {
-      Evidence& e = evidence(cell);
-      e.off_field += static_cast<float>(removal_samples_stride_);
-      if (e.off_field >= (ball ? 1 : kMinOffFieldSightings) * removal_samples_stride_ &&
-          e.off_field > evidenceRatio(k, c) * e.in_field) {
-        removeCell(cell);
-        confirmed_[cell] = 0;
-        ++stats.removed[k];
+  constexpr ptrdiff_t kAhead = 16;
+  for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
+    const auto [begin, end] = candidate_spans_[static_cast<size_t>(sector)];
+    for (const RemovalSample* next = begin; next != end; ++next) {
+      if (end - next > kAhead) {
+        const RemovalSample& ahead = next[kAhead];
+        model_.prefetchRay(ahead.pixel);
+        __builtin_prefetch(pixels.address(ahead.pixel, ahead.u, ahead.v));
+      }
+      const RemovalSample& sample = *next;
+      // The color first: most colors seen off the field are mapped to no class, and then whether
+      // the pixel really is off the field (a ray cast) does not matter.
+      uint8_t c[3];
+      pixels.color(sample.pixel, sample.u, sample.v, c);
+      const uint32_t cell = lut_.index(c[0], c[1], c[2]);
+      if (!mapped(cell)) continue;  // the bitmap fits the L1 cache, the table does not
+      const uint8_t k = lut_.at(cell);
+      if (k >= kNumClasses) continue;
+      if (k == kBlack && maybeRobot(sector, sample.range_m, pixels)) continue;
+      if (!model_.offField(sample.pixel, transform)) continue;
+      ++stats.remove_candidates;
+      // The ball is one small object whose colors are never expected from the pose: one sighting off
+      // the field counts.
+      const bool ball = k == kOrange;
+      if (params_.evidence_removal_ratio > 0) {
+        Evidence& e = evidence(cell);
+        e.off_field += static_cast<float>(removal_samples_stride_);
+        if (e.off_field >= (ball ? 1 : kMinOffFieldSightings) * removal_samples_stride_ &&
+            e.off_field > evidenceRatio(k, c) * e.in_field) {
+          removeCell(cell);
+          confirmed_[cell] = 0;
+          ++stats.removed[k];
+          continue;
+        }
+        // And kept: a color the field shows as k at least kEvidenceKeepRatio times as often as the
+        // hall, however far from the cluster (the evidence decides where it is clear, 2.4's distance
+        // elsewhere).
+        if (!neighbour_only_[cell] && e.in_field >= kEvidenceKeepRatio * e.off_field) continue;
+      }
+      // removal_protect_cycles: the robots' colors, which the hall's dark clutter shows too, stay
+      // while robots on the field confirm them. The field's own classes have their clusters and the
+      // evidence: protected, a goal kept a hall poster of its color (tuning seed 12) and white the
+      // hall's whitish cells (tuning split 20 class segments up by 0.02 or more in F1, 3 down).
+      if (k == kBlack && confirmed_[cell] != 0 &&
+          revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
         continue;
       }
-      // And kept: a color the field shows as k at least kEvidenceKeepRatio times as often as the
-      // hall, however far from the cluster (the evidence decides where it is clear, 2.4's distance
-      // elsewhere).
-      if (!neighbour_only_[cell] && e.in_field >= kEvidenceKeepRatio * e.off_field) continue;
-    }
-    // removal_protect_cycles: the robots' colors, which the hall's dark clutter shows too, stay
-    // while robots on the field confirm them. The field's own classes have their clusters and the
-    // evidence: protected, a goal kept a hall poster of its color (tuning seed 12) and white the
-    // hall's whitish cells (tuning split 20 class segments up by 0.02 or more in F1, 3 down).
-    if (k == kBlack && confirmed_[cell] != 0 &&
-        revision_ + 1 - confirmed_[cell] < static_cast<uint64_t>(params_.removal_protect_cycles)) {
-      continue;
-    }
-    if (neighbour_only_[cell] ||
-        (remove_mean[k] - Eigen::Vector3f(c[0], c[1], c[2])).squaredNorm() > remove_radius_sq[k]) {
-      removeCell(cell);
-      ++stats.removed[k];
+      if (neighbour_only_[cell] ||
+          (remove_mean[k] - Eigen::Vector3f(c[0], c[1], c[2])).squaredNorm() > remove_radius_sq[k]) {
+        removeCell(cell);
+        ++stats.removed[k];
+      }
     }
   }
 }

@@ -456,9 +456,11 @@ class ActTrainer {
   const RemovalSamples& removalSamples(size_t start);
   std::unordered_map<size_t, RemovalSamples> removal_samples_;
   std::array<double, ExpectedClassModel::kRemovalSectors> sector_safe_range_{};
-  std::vector<RemovalSample> candidates_;   // scratch: this cycle's samples that may be off the field
-  std::vector<uint8_t> candidate_sectors_;  // their sectors
-  // Fills candidates_ from the samples of `start` (sector_safe_range_ of the pose).
+  // This cycle's samples that may be off the field: per sector, a prefix of its list in
+  // removalSamples (read in place: copied, they cost a tenth of the cycle's cache misses).
+  std::array<std::pair<const RemovalSample*, const RemovalSample*>, ExpectedClassModel::kRemovalSectors>
+      candidate_spans_{};
+  // Fills candidate_spans_ from the samples of `start` (sector_safe_range_ of the pose).
   void selectRemovalCandidates(size_t start);
   // ActParams::robot_height_m. A robot standing at floor range d is imaged out to d * robot_reach_
   // (its top). Per sector, this cycle's samples on the carpet from safe range / robot_reach_ on (a
@@ -473,7 +475,7 @@ class ActTrainer {
   // or a neighbouring one: a robot at 5 m spans about a sector).
   template <class Pixels>
   bool maybeRobot(int sector, float range_m, const Pixels& pixels);
-  // 2.4 on candidates_, reading their colors through `pixels` (see act_trainer.cpp).
+  // 2.4 on candidate_spans_, reading their colors through `pixels` (see act_trainer.cpp).
   template <class Pixels>
   void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
   int removal_samples_stride_ = 0;
