@@ -142,23 +142,6 @@ T valueOfRank(std::vector<T>& values, size_t rank) {
   return *at;
 }
 
-// Per channel, the value of the given rank (0: the smallest) among colors whose channels are byte
-// values: counted in one pass (valueOfRank's selection, once per channel, was 3% of a cycle).
-Eigen::Vector3f channelValuesOfRank(const std::vector<Eigen::Vector3f>& colors, size_t rank) {
-  std::array<std::array<uint32_t, 256>, 3> counts{};
-  for (const Eigen::Vector3f& c : colors) {
-    for (int ch = 0; ch < 3; ++ch) ++counts[ch][static_cast<uint8_t>(c[ch])];
-  }
-  Eigen::Vector3f out;
-  for (int ch = 0; ch < 3; ++ch) {
-    size_t below = 0;
-    int value = 0;
-    while (value < 255 && below + counts[ch][value] <= rank) below += counts[ch][value++];
-    out[ch] = static_cast<float>(value);
-  }
-  return out;
-}
-
 }  // namespace
 
 void ActParams::validate() const {
@@ -703,7 +686,12 @@ void ActTrainer::measureCarpetColor() {
   // their grey (fresh seed 2026: yellow F1 0.10, a fixed table's 0.99).
   goal_min_chroma_ = 0;
   if (!carpetMeasurable()) return;
-  const Eigen::Vector3f median = channelValuesOfRank(carpet_samples_, carpet_samples_.size() / 2);
+  // Counted, not selected (valueOfRank once per channel was 3% of a cycle).
+  ChannelHistograms histograms;
+  histograms.count(carpet_samples_);
+  Eigen::Vector3f median;
+  for (int ch = 0; ch < 3; ++ch)
+    median[ch] = static_cast<float>(histograms.valueOfRank(ch, carpet_samples_.size() / 2));
   goal_min_chroma_ = kGoalMinChromaOfCarpet * chroma(median, lut_.colorSpace());
 }
 

@@ -166,6 +166,21 @@ double LightModel::Map::maxSlope(const Eigen::Vector3d& x, double half_width) co
   return slope;
 }
 
+void ChannelHistograms::count(const std::vector<Eigen::Vector3f>& colors) {
+  for (auto& h : counts) h.fill(0);
+  for (const Eigen::Vector3f& color : colors) {
+    for (int c = 0; c < 3; ++c) ++counts[c][static_cast<uint8_t>(color[c])];
+  }
+}
+
+int ChannelHistograms::valueOfRank(int ch, size_t rank) const {
+  const std::array<uint32_t, 256>& histogram = counts[static_cast<size_t>(ch)];
+  size_t below = 0;
+  int value = 0;
+  while (value < 255 && below + histogram[value] <= rank) below += histogram[value++];
+  return value;
+}
+
 void LightModel::observe(const std::vector<Eigen::Vector3f>& green, const std::vector<Eigen::Vector3f>& white,
                          const std::vector<Eigen::Vector3f>& chassis) {
   const std::array<const std::vector<Eigen::Vector3f>*, kAnchorClasses> samples = {&chassis, &green, &white};
@@ -175,14 +190,10 @@ void LightModel::observe(const std::vector<Eigen::Vector3f>& green, const std::v
     const auto& s = *samples[a];
     if (s.size() < kMinSamples[a]) continue;
     q.assign(kLevels[a].size(), Eigen::Vector3d::Zero());
-    // Quantiles from a histogram per channel (colors are 8-bit): linear in the samples, no sort;
-    // the three channels counted in one pass.
-    for (auto& h : histograms_) h.fill(0);
-    for (const auto& color : s) {
-      for (int c = 0; c < 3; ++c) ++histograms_[c][static_cast<uint8_t>(color[c])];
-    }
+    // Quantiles from a histogram per channel (colors are 8-bit): linear in the samples, no sort.
+    histograms_.count(s);
     for (int c = 0; c < 3; ++c) {
-      const std::array<uint32_t, 256>& histogram = histograms_[c];
+      const std::array<uint32_t, 256>& histogram = histograms_.counts[c];
       uint32_t below = 0;  // samples in the bins before `bin`
       int bin = 0;
       for (size_t l = 0; l < kLevels[a].size(); ++l) {

@@ -32,6 +32,16 @@ struct ShadeLine {
   }
 };
 
+// Per-channel histograms of colors whose channels are byte values (8-bit images), counted in one
+// pass over them: quantiles linear in the samples, without sorting.
+struct ChannelHistograms {
+  std::array<std::array<uint32_t, 256>, 3> counts{};
+  // Replaces the counts with those of `colors`.
+  void count(const std::vector<Eigen::Vector3f>& colors);
+  // The value of the given rank (0: the smallest; below the number counted) in channel `ch`.
+  int valueOfRank(int ch, size_t rank) const;
+};
+
 class LightModel {
  public:
   // f(x) for x = 0 ... 256 (the upper end of the last color value), per channel.
@@ -90,7 +100,7 @@ class LightModel {
   };
   Anchors current_, reference_;
   bool has_reference_ = false;
-  std::array<std::array<uint32_t, 256>, 3> histograms_{};  // scratch, per channel
+  ChannelHistograms histograms_;  // scratch
 };
 
 }  // namespace core
