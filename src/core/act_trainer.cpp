@@ -76,6 +76,8 @@ constexpr double kMajorityEvidenceRatio = 1.0;
 constexpr uint8_t kClippedValue = 254;
 constexpr double kClippedEvidenceRatio = 5.0;
 
+bool clipped(const uint8_t c[3]) { return std::max({c[0], c[1], c[2]}) >= kClippedValue; }
+
 // The change of light's own cycle and the ones after it, up to this many in all, add every
 // light_change_add_stride-th pixel. At one cycle, white took more than 2 cycles to settle after 51
 // of 72 sudden changes of the tuning split (some 10 line samples a cycle at add_stride: the line
@@ -294,6 +296,7 @@ void ActTrainer::reset(ColorSpace space) {
   carpet_shaded_ = false;
   light_states_.clear();
   last_light_change_ = 0;
+  unclassed_samples_ = 0;
   restartPoseCheck();
   ball_hypotheses_.clear();
   ball_last_seen_ = 0;
@@ -632,8 +635,7 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
 double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
   const double majority = std::min(params_.evidence_removal_ratio, kMajorityEvidenceRatio);
   if (k == kOrange) return majority;  // clipped or not
-  if (std::max({c[0], c[1], c[2]}) >= kClippedValue)
-    return std::max(params_.evidence_removal_ratio, kClippedEvidenceRatio);
+  if (clipped(c)) return std::max(params_.evidence_removal_ratio, kClippedEvidenceRatio);
   if (k == kGreen || k == kYellow || k == kBlue) return majority;
   return params_.evidence_removal_ratio;
 }
@@ -837,7 +839,10 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
   // counts have grown. (Counts copied from the last cell that mapped to a cell, and those of cells
   // of no class left where they were: the lines took 24 cycles to come back after the paper's
   // darkening on nubot_1 instead of 1; on the tuning split white and black took 5.5 and 10
-  // cycles to settle after a sudden change (medians) instead of 2 and 1.)
+  // cycles to settle after a sudden change (medians) instead of 2 and 1.) The off-field counts of
+  // colors of no class stay behind: under the new light the hall's colors are counted again, and
+  // moved, those a darkening packed into the lines' cells removed them at once (nubot_1's white took
+  // 16 cycles to come back after the paper's darkening instead of 3).
   const uint32_t now = static_cast<uint32_t>(revision_ + 1);
   warped_evidence_.assign(evidence_.size(), Evidence{0.f, 0.f, now});
   const uint32_t mask = (1u << bits) - 1;
@@ -870,7 +875,7 @@ void ActTrainer::applyLightChange(const LightModel::Map& map) {
             warped_neighbour_only_[target] = neighbour_only_[cell];
           }
           warped_evidence_[target].in_field += share * counts.in_field;
-          warped_evidence_[target].off_field += share * counts.off_field;
+          if (classed) warped_evidence_[target].off_field += share * counts.off_field;
         }
       }
     }
@@ -1439,11 +1444,25 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
       }
       const RemovalSample& sample = *next;
       // The color first: most colors seen off the field are mapped to no class, and then whether
-      // the pixel really is off the field (a ray cast) does not matter.
+      // the pixel really is off the field (a ray cast) matters for one in kUnclassedSightingStride.
       uint8_t c[3];
       pixels.color(sample.pixel, sample.u, sample.v, c);
       const uint32_t cell = lut_.index(c[0], c[1], c[2]);
-      if (!mapped(cell)) continue;  // the bitmap fits the L1 cache, the table does not
+      if (!mapped(cell)) {  // the bitmap fits the L1 cache, the table does not
+        // A color of no class seen off the field is counted as well, as a fixed table's majority
+        // counts every pixel: when the field first shows a color of the hall, its count against it
+        // is there, and one in-field sample does not add it (counted only while a class had it, the
+        // hall's colors beside the lines came and went with every line sample: tuning split white
+        // F1 up by 0.02 or more in 16 segments, down in 1). Not a clipped color (a saturated line
+        // is a saturated lamp: kClippedEvidenceRatio; counted, a brightening that clips the lines
+        // lost them for good, tuning scene 88) and not where a robot may stand. Every
+        // kUnclassedSightingStride-th such sample counts, for that many.
+        if (params_.evidence_removal_ratio > 0 && ++unclassed_samples_ % kUnclassedSightingStride == 0 && !clipped(c) &&
+            !maybeRobot(sector, sample.range_m, pixels) && model_.offField(sample.pixel, transform)) {
+          evidence(cell).off_field += static_cast<float>(kUnclassedSightingStride * removal_samples_stride_);
+        }
+        continue;
+      }
       const uint8_t k = lut_.at(cell);
       if (k >= kNumClasses) continue;
       if (k == kBlack && maybeRobot(sector, sample.range_m, pixels)) continue;

@@ -817,6 +817,49 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   EXPECT_LT(run(255, 1), 0.1);
 }
 
+TEST_F(ActTrainerTest, AHallColorOfNoClassIsCountedBeforeTheLinesShowIt) {
+  // A grey the hall beside the field shows on some rows, some four times as often as the lines
+  // will, and that no class has. Then the lines take it too: a fixed table gives it to the hall.
+  // 2.4 has counted the hall's sightings of it while it had no class, so the lines' samples do not
+  // add it; counted only while a class had it, every in-field sample found no count against it and
+  // added it until the hall's sightings removed it again. Shown by the lines alone, it is white.
+  const Pose2D near_corner{7.5, 4.5, 0.0};
+  const auto clean = paintFlatFrame(model, near_corner, 1.0, 1);
+  const PoseTransform t(near_corner);
+  cv::Mat lines(580, 580, CV_8U, cv::Scalar(0)), hall(580, 580, CV_8U, cv::Scalar(0));
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      lines.at<uint8_t>(v, u) = model.geometricClass(v * 580 + u, t) == kWhite;
+      hall.at<uint8_t>(v, u) = model.offField(v * 580 + u, t);
+    }
+  }
+  const int line_pixels = cv::countNonZero(lines);
+  ASSERT_GT(line_pixels, 1000);
+  const int some_rows = rowStepFor(hall, line_pixels, 4.0);
+  ASSERT_NEAR(rowsShare(hall, some_rows, line_pixels), 4.0, 0.4);
+  const uint8_t grey = 195;
+  auto run = [&](bool hall_shows_it) {
+    ActTrainer trainer(cal, ActParams());
+    trainer.bootstrap(view(clean.rgb), near_corner, 30);
+    EXPECT_NE(trainer.lut().classOf(grey, grey, grey), kWhite);
+    cv::Mat frame = clean.rgb.clone();
+    const cv::Scalar color(grey, grey, grey);
+    if (hall_shows_it) {
+      for (int v = 0; v < 580; v += some_rows) frame.row(v).setTo(color, hall.row(v));
+    }
+    for (int i = 0; i < 40; ++i) trainer.cycle(view(frame), near_corner);
+    frame.setTo(color, lines);
+    int white = 0;
+    for (int i = 0; i < 100; ++i) {
+      trainer.cycle(view(frame), near_corner);
+      white += trainer.lut().classOf(grey, grey, grey) == kWhite;
+    }
+    return white / 100.0;
+  };
+  EXPECT_LT(run(true), 0.05);
+  EXPECT_GT(run(false), 0.9);
+}
+
 TEST_F(ActTrainerTest, ARegionsColorTheHallShowsMoreOftenIsTheHalls) {
   // A frame without noise, each class in one color; part of a region (a band of the carpet, the
   // yellow goal) in a color within xi sigma of its class (2.4's distance keeps it), shown by some
