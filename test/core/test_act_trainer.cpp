@@ -68,6 +68,27 @@ class ActTrainerTest : public ::testing::Test {
     }
     return cv::Vec3b(0, 0, 0);
   }
+  // Masks of the pixels the model expects as the lines at `at` and of those it sees off the field,
+  // and the row step whose hall pixels come nearest to four times the line pixels.
+  struct LinesAndHall {
+    cv::Mat lines, hall;
+    int line_pixels = 0;
+    int some_rows = 0;
+  };
+  LinesAndHall linesAndHall(const Pose2D& at) const {
+    const PoseTransform t(at);
+    LinesAndHall out{cv::Mat(580, 580, CV_8U, cv::Scalar(0)), cv::Mat(580, 580, CV_8U, cv::Scalar(0))};
+    for (int v = 0; v < 580; ++v) {
+      for (int u = 0; u < 580; ++u) {
+        out.lines.at<uint8_t>(v, u) = model.geometricClass(v * 580 + u, t) == kWhite;
+        out.hall.at<uint8_t>(v, u) = model.offField(v * 580 + u, t);
+      }
+    }
+    out.line_pixels = cv::countNonZero(out.lines);
+    EXPECT_GT(out.line_pixels, 1000);
+    out.some_rows = rowStepFor(out.hall, out.line_pixels, 4.0);
+    return out;
+  }
   // Paints `color` (truth kBlack) over the pixels expected as class k whose bearing around the
   // mirror's centre lies in the first `width_deg` of every `period_deg`, as robots and struts
   // near the robot are. Returns the pixels expected as k and those painted.
@@ -780,27 +801,16 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
   // (some 30 times as often), it is removed too.
   const Pose2D near_corner{7.5, 4.5, 0.0};
   const auto clean = paintFlatFrame(model, near_corner, 1.0, 1);
-  const PoseTransform t(near_corner);
-  cv::Mat lines(580, 580, CV_8U, cv::Scalar(0)), hall(580, 580, CV_8U, cv::Scalar(0));
-  for (int v = 0; v < 580; ++v) {
-    for (int u = 0; u < 580; ++u) {
-      lines.at<uint8_t>(v, u) = model.geometricClass(v * 580 + u, t) == kWhite;
-      hall.at<uint8_t>(v, u) = model.offField(v * 580 + u, t);
-    }
-  }
-  const int line_pixels = cv::countNonZero(lines);
-  ASSERT_GT(line_pixels, 1000);
-  // The row step whose painted hall pixels come nearest to four times the line pixels.
-  const int some_rows = rowStepFor(hall, line_pixels, 4.0);
-  ASSERT_NEAR(rowsShare(hall, some_rows, line_pixels), 4.0, 0.4);
+  const LinesAndHall s = linesAndHall(near_corner);
+  ASSERT_NEAR(rowsShare(s.hall, s.some_rows, s.line_pixels), 4.0, 0.4);
   auto run = [&](uint8_t value, int every_nth_row) {
     const cv::Scalar color(value, value, value);
     cv::Mat frame = clean.rgb.clone();
-    frame.setTo(color, lines);
+    frame.setTo(color, s.lines);
     ActTrainer trainer(cal, ActParams());
     trainer.bootstrap(view(frame), near_corner, 30);
     EXPECT_EQ(trainer.lut().classOf(value, value, value), kWhite) << int(value);
-    for (int v = 0; v < 580; v += every_nth_row) frame.row(v).setTo(color, hall.row(v));
+    for (int v = 0; v < 580; v += every_nth_row) frame.row(v).setTo(color, s.hall.row(v));
     // The in-field counts of the start-up decay (half-life 40 cycles); then the fraction of
     // cycles in which the color is white (a removed cell comes back when the in-field count
     // catches up, and goes again).
@@ -812,8 +822,8 @@ TEST_F(ActTrainerTest, AClippedColorNeedsStrongerEvidenceThanOthers) {
     }
     return white / 100.0;
   };
-  EXPECT_LT(run(240, some_rows), 0.3);
-  EXPECT_GT(run(255, some_rows), 0.9);
+  EXPECT_LT(run(240, s.some_rows), 0.3);
+  EXPECT_GT(run(255, s.some_rows), 0.9);
   EXPECT_LT(run(255, 1), 0.1);
 }
 
@@ -823,35 +833,25 @@ TEST_F(ActTrainerTest, AHallColorOfNoClassIsCountedBeforeTheLinesShowIt) {
   // 2.4 has counted the hall's sightings of it while it had no class, so the lines' samples do not
   // add it; counted only while a class had it, every in-field sample found no count against it and
   // added it until the hall's sightings removed it again. Shown by the lines alone, it is white.
-  const Pose2D near_corner{7.5, 4.5, 0.0};
-  const auto clean = paintFlatFrame(model, near_corner, 1.0, 1);
-  const PoseTransform t(near_corner);
-  cv::Mat lines(580, 580, CV_8U, cv::Scalar(0)), hall(580, 580, CV_8U, cv::Scalar(0));
-  for (int v = 0; v < 580; ++v) {
-    for (int u = 0; u < 580; ++u) {
-      lines.at<uint8_t>(v, u) = model.geometricClass(v * 580 + u, t) == kWhite;
-      hall.at<uint8_t>(v, u) = model.offField(v * 580 + u, t);
-    }
-  }
-  const int line_pixels = cv::countNonZero(lines);
-  ASSERT_GT(line_pixels, 1000);
-  const int some_rows = rowStepFor(hall, line_pixels, 4.0);
-  ASSERT_NEAR(rowsShare(hall, some_rows, line_pixels), 4.0, 0.4);
+  const Pose2D at{7.5, 4.5, 0.0};
+  const LinesAndHall masks = linesAndHall(at);
+  ASSERT_NEAR(rowsShare(masks.hall, masks.some_rows, masks.line_pixels), 4.0, 0.4);
+  const cv::Mat clean = paintFlatFrame(model, at, 1.0, 1).rgb;
   const uint8_t grey = 195;
   auto run = [&](bool hall_shows_it) {
     ActTrainer trainer(cal, ActParams());
-    trainer.bootstrap(view(clean.rgb), near_corner, 30);
+    trainer.bootstrap(view(clean), at, 30);
     EXPECT_NE(trainer.lut().classOf(grey, grey, grey), kWhite);
-    cv::Mat frame = clean.rgb.clone();
+    cv::Mat frame = clean.clone();
     const cv::Scalar color(grey, grey, grey);
     if (hall_shows_it) {
-      for (int v = 0; v < 580; v += some_rows) frame.row(v).setTo(color, hall.row(v));
+      for (int v = 0; v < 580; v += masks.some_rows) frame.row(v).setTo(color, masks.hall.row(v));
     }
-    for (int i = 0; i < 40; ++i) trainer.cycle(view(frame), near_corner);
-    frame.setTo(color, lines);
+    for (int i = 0; i < 40; ++i) trainer.cycle(view(frame), at);
+    frame.setTo(color, masks.lines);
     int white = 0;
     for (int i = 0; i < 100; ++i) {
-      trainer.cycle(view(frame), near_corner);
+      trainer.cycle(view(frame), at);
       white += trainer.lut().classOf(grey, grey, grey) == kWhite;
     }
     return white / 100.0;
