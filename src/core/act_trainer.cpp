@@ -1172,6 +1172,7 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   });
 
   model_.sectorSafeRanges(pose, sector_safe_range_);
+  model_.sectorOffRanges(pose, sector_off_range_);
   if (params_.ball_training) trainBall(image, transform, stats);
 
   // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it.
@@ -1436,6 +1437,11 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
   constexpr ptrdiff_t kAhead = 16;
   for (int sector = 0; sector < ExpectedClassModel::kRemovalSectors; ++sector) {
     const auto [begin, end] = candidate_spans_[static_cast<size_t>(sector)];
+    // Beyond the sector's off range no ray cast is needed (sectorOffRanges).
+    const double off_range = sector_off_range_[static_cast<size_t>(sector)];
+    auto offField = [&](const RemovalSample& s) {
+      return s.range_m > off_range || model_.offField(s.pixel, transform);
+    };
     for (const RemovalSample* next = begin; next != end; ++next) {
       if (end - next > kAhead) {
         const RemovalSample& ahead = next[kAhead];
@@ -1458,7 +1464,7 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
         // lost them for good, tuning scene 88) and not where a robot may stand. Every
         // kUnclassedSightingStride-th such sample counts, for that many.
         if (params_.evidence_removal_ratio > 0 && ++unclassed_samples_ % kUnclassedSightingStride == 0 && !clipped(c) &&
-            !maybeRobot(sector, sample.range_m, pixels) && model_.offField(sample.pixel, transform)) {
+            !maybeRobot(sector, sample.range_m, pixels) && offField(sample)) {
           evidence(cell).off_field += static_cast<float>(kUnclassedSightingStride * removal_samples_stride_);
         }
         continue;
@@ -1466,7 +1472,7 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
       const uint8_t k = lut_.at(cell);
       if (k >= kNumClasses) continue;
       if (k == kBlack && maybeRobot(sector, sample.range_m, pixels)) continue;
-      if (!model_.offField(sample.pixel, transform)) continue;
+      if (!offField(sample)) continue;
       ++stats.remove_candidates;
       // The ball is one small object whose colors are never expected from the pose: one sighting off
       // the field counts.

@@ -19,6 +19,17 @@ ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
                                ray.region == PixelRegion::kSelf;
     removal_range_m_[i] = never_unknown ? -std::numeric_limits<float>::infinity() : ground_range_m_[i];
   }
+  // How far the bearings of the floor points and above-horizon rays (which a tilt turns) reach
+  // beyond the sectors removalSector puts them in.
+  const double step = 2.0 * M_PI / kRemovalSectors;
+  for (size_t i = 0; i < ground_range_m_.size(); ++i) {
+    const PixelRay& ray = camera_.ray(i);
+    if (ray.region != PixelRegion::kFloor && ray.region != PixelRegion::kAboveHorizon) continue;
+    const double bearing = ray.region == PixelRegion::kFloor ? std::atan2(ray.ground_y_m, ray.ground_x_m)
+                                                             : std::atan2(ray.dir_y, ray.dir_x);
+    const double d = std::abs(std::remainder(bearing - (removalSector(i) + 0.5) * step, 2.0 * M_PI));
+    sector_bearing_reach_ = std::max(sector_bearing_reach_, d - 0.5 * step);
+  }
 }
 
 template <bool kTellLines>
@@ -119,6 +130,79 @@ void ExpectedClassModel::sectorSafeRanges(const Pose2D& pose, std::array<double,
     const double next_c = c * cos_step - sn * sin_step;
     sn = sn * cos_step + c * sin_step;
     c = next_c;
+  }
+}
+
+void ExpectedClassModel::sectorOffRanges(const Pose2D& pose, std::array<double, kRemovalSectors>& out) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kTwoPi = 2.0 * M_PI;
+  constexpr double kStep = kTwoPi / kRemovalSectors;
+  constexpr double kMargin = 1e-3;  // rad: rounding of the bearings
+  out.fill(kInf);
+  const double half_length = field_.halfLength() + field_.calibration().margin_m;
+  const double half_width = field_.halfWidth() + field_.calibration().margin_m;
+  const double x = pose.x_m, y = pose.y_m;
+  if (!(std::abs(x) < half_length && std::abs(y) < half_width)) return;
+  // Sector s holds the bearings (field frame, relative to theta) [s step - reach, (s + 1) step +
+  // reach], reach the pixels' largest bearing beyond their nominal sector plus a margin.
+  const double reach = sector_bearing_reach_ + kMargin;
+  // Marks the sectors whose bearings meet [a - half, a + half] (a relative to theta).
+  auto sectorsMeeting = [&](double a, double half, auto&& mark) {
+    a = std::fmod(a, kTwoPi);
+    if (a < 0) a += kTwoPi;
+    const int first = static_cast<int>(std::floor((a - half - reach) / kStep));
+    const int last = static_cast<int>(std::floor((a + half + reach) / kStep));
+    for (int k = first; k <= std::min(last, first + kRemovalSectors - 1); ++k) {
+      mark(static_cast<size_t>(((k % kRemovalSectors) + kRemovalSectors) % kRemovalSectors));
+    }
+  };
+  // A ray meets a goal box only if its bearing points into the goal's footprint.
+  std::array<bool, kRemovalSectors> goal{};
+  for (int i = 0; i < 2; ++i) {
+    Eigen::Vector3d lo, hi;
+    field_.goalBox(i == 0 ? kYellow : kBlue, &lo, &hi);
+    if (x >= lo.x() - 1e-6 && x <= hi.x() + 1e-6 && y >= lo.y() - 1e-6 && y <= hi.y() + 1e-6) return;
+    const double centre = std::atan2(0.5 * (lo.y() + hi.y()) - y, 0.5 * (lo.x() + hi.x()) - x);
+    double half = 0.0;
+    for (const double cx : {lo.x(), hi.x()}) {
+      for (const double cy : {lo.y(), hi.y()}) {
+        half = std::max(half, std::abs(std::remainder(std::atan2(cy - y, cx - x) - centre, kTwoPi)));
+      }
+    }
+    sectorsMeeting(centre - pose.theta_rad, half, [&](size_t s) { goal[s] = true; });
+  }
+  // Leaving a convex carpet, the farthest exit over a sector's bearings is at one of their ends or
+  // at a corner of the carpet between them. Ends: each sector boundary +- reach.
+  auto exitRange = [&](double c, double s) {
+    const double tx = c > 0 ? (half_length - x) / c : c < 0 ? (-half_length - x) / c : kInf;
+    const double ty = s > 0 ? (half_width - y) / s : s < 0 ? (-half_width - y) / s : kInf;
+    return std::min(tx, ty);
+  };
+  std::array<double, kRemovalSectors> boundary{};
+  const double cos_step = std::cos(kStep), sin_step = std::sin(kStep);
+  for (const double offset : {-reach, reach}) {
+    double c = std::cos(pose.theta_rad + offset), sn = std::sin(pose.theta_rad + offset);
+    for (int k = 0; k < kRemovalSectors; ++k) {
+      boundary[static_cast<size_t>(k)] = std::max(boundary[static_cast<size_t>(k)], exitRange(c, sn));
+      const double next_c = c * cos_step - sn * sin_step;
+      sn = sn * cos_step + c * sin_step;
+      c = next_c;
+    }
+  }
+  std::array<double, kRemovalSectors> far{};
+  for (int k = 0; k < kRemovalSectors; ++k) {
+    far[static_cast<size_t>(k)] =
+        std::max(boundary[static_cast<size_t>(k)], boundary[static_cast<size_t>((k + 1) % kRemovalSectors)]);
+  }
+  for (const double cx : {-half_length, half_length}) {
+    for (const double cy : {-half_width, half_width}) {
+      const double distance = std::hypot(cx - x, cy - y);
+      sectorsMeeting(std::atan2(cy - y, cx - x) - pose.theta_rad, 0.0,
+                     [&](size_t s) { far[s] = std::max(far[s], distance); });
+    }
+  }
+  for (size_t s = 0; s < out.size(); ++s) {
+    if (!goal[s] && sector_bearing_reach_ < kStep) out[s] = far[s] * (1.0 + 1e-6) + 1e-6;
   }
 }
 

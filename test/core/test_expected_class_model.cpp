@@ -157,6 +157,47 @@ TEST(ExpectedClassModel, PixelsBelowTheirSectorsSafeRangeAreNeverUnknown) {
   EXPECT_NEAR(safe[0], 9.0, 1e-3);
 }
 
+TEST(ExpectedClassModel, PixelsBeyondTheirSectorsOffRangeAreAlwaysOffTheField) {
+  // The removal step trusts sectorOffRanges instead of a ray cast: every pixel beyond its sector's
+  // off range must be off the field, at poses all over the carpet, near the goals and its corners,
+  // on the contract's camera and on a tilted one.
+  for (const bool tilted : {false, true}) {
+    Calibration cal = act_color::test::defaultCalibration();
+    if (tilted) {
+      cal.camera.tilt_x_rad = 0.03;
+      cal.camera.tilt_y_rad = -0.02;
+    }
+    const ExpectedClassModel model(cal);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> x(-9.9, 9.9), y(-6.9, 6.9), th(-M_PI, M_PI);
+    std::array<double, ExpectedClassModel::kRemovalSectors> off;
+    size_t shortcut = 0, off_field = 0;
+    for (int trial = 0; trial < 16; ++trial) {
+      const Pose2D pose = trial == 0   ? Pose2D{0, 0, 0}
+                          : trial == 1 ? Pose2D{8.8, 0.5, 2.0}
+                                       : Pose2D{x(rng), y(rng), th(rng)};
+      const PoseTransform t(pose);
+      model.sectorOffRanges(pose, off);
+      for (size_t i = 0; i < 580u * 580u; i += 3) {
+        const float range = model.removalRange(i);
+        if (!(range > -std::numeric_limits<float>::infinity())) continue;
+        const bool is_off = model.offField(i, t);
+        off_field += is_off;
+        if (!(range > off[static_cast<size_t>(model.removalSector(i))])) continue;
+        ++shortcut;
+        ASSERT_TRUE(is_off) << "pose " << pose.x_m << " " << pose.y_m << " " << pose.theta_rad << " pixel " << i;
+      }
+    }
+    // Most pixels off the field need no ray cast.
+    EXPECT_GT(shortcut, off_field / 2) << tilted;
+  }
+  // Off the carpet: no sector is trusted.
+  const ExpectedClassModel model(act_color::test::defaultCalibration());
+  std::array<double, ExpectedClassModel::kRemovalSectors> off;
+  model.sectorOffRanges(Pose2D{0.0, 9.0, 0.0}, off);
+  for (const double r : off) EXPECT_EQ(r, std::numeric_limits<double>::infinity());
+}
+
 TEST(ExpectedClassModel, ExpectedLabelsMarkRejectedWhite) {
   const ExpectedClassModel model(act_color::test::defaultCalibration());
   cv::Mat flat(580, 580, CV_8UC3, cv::Scalar(50, 140, 50));  // lines invisible: eq. 1 rejects them all

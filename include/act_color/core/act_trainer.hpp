@@ -461,6 +461,7 @@ class ActTrainer {
   const RemovalSamples& removalSamples(size_t start);
   std::unordered_map<size_t, RemovalSamples> removal_samples_;
   std::array<double, ExpectedClassModel::kRemovalSectors> sector_safe_range_{};
+  std::array<double, ExpectedClassModel::kRemovalSectors> sector_off_range_{};  // sectorOffRanges
   // This cycle's samples that may be off the field: per sector, a prefix of its list in
   // removalSamples (read in place: copied, they cost a tenth of the cycle's cache misses).
   std::array<std::pair<const RemovalSample*, const RemovalSample*>, ExpectedClassModel::kRemovalSectors>

@@ -57,6 +57,12 @@ class ExpectedClassModel {
   // lines plus margin and to the goal lines; 0 everywhere when the robot is beyond them). At least
   // safeCarpetRange in directions away from the goals, and larger in most.
   void sectorSafeRanges(const Pose2D& pose, std::array<double, kRemovalSectors>& out) const;
+  // Per sector, a ground range beyond which offField is true at this pose without a ray cast:
+  // every floor point the sector's pixels see beyond it is off the carpet, and none of the sector's
+  // rays can meet a goal (the goals' footprints lie in other bearings). +inf for sectors that may
+  // see a goal, and everywhere when the robot is off the carpet; above-horizon pixels have the
+  // range +inf, so that they pass in the other sectors.
+  void sectorOffRanges(const Pose2D& pose, std::array<double, kRemovalSectors>& out) const;
 
   // For the removal step (2.4): one float per pixel, -inf for pixels that are never kUnknown (not
   // imaged, chassis), else the floor range. mayBeOffField is false when geometricClass cannot be
@@ -90,6 +96,9 @@ class ExpectedClassModel {
   OmniCameraModel camera_;
   // Ground distance of each floor pixel's floor point; +inf for others.
   std::vector<float> ground_range_m_;
+  // How far (rad) the bearings of floor points and above-horizon rays reach beyond their removal
+  // sector (a tilted mirror turns them; 0 when none does).
+  double sector_bearing_reach_ = 0.0;
   // ground_range_m_, but -inf for pixels that are never kUnknown (not imaged, chassis): the
   // removal step skips most pixels with this one compact array instead of the 32-byte rays.
   std::vector<float> removal_range_m_;
