@@ -139,10 +139,10 @@ void ExpectedClassModel::sectorOffRanges(const Pose2D& pose, std::array<double, 
   constexpr double kStep = kTwoPi / kRemovalSectors;
   constexpr double kMargin = 1e-3;  // rad: rounding of the bearings
   out.fill(kInf);
-  const double half_length = field_.halfLength() + field_.calibration().margin_m;
-  const double half_width = field_.halfWidth() + field_.calibration().margin_m;
+  const double half_length = field_.carpetHalfLength(), half_width = field_.carpetHalfWidth();
   const double x = pose.x_m, y = pose.y_m;
-  if (!(std::abs(x) < half_length && std::abs(y) < half_width)) return;
+  // Off the carpet, or bearings a tilt turns by more than a sector: no shortcut.
+  if (!(std::abs(x) < half_length && std::abs(y) < half_width) || !(sector_bearing_reach_ < kStep)) return;
   // Sector s holds the bearings (field frame, relative to theta) [s step - reach, (s + 1) step +
   // reach], reach the pixels' largest bearing beyond their nominal sector plus a margin.
   const double reach = sector_bearing_reach_ + kMargin;
@@ -202,7 +202,7 @@ void ExpectedClassModel::sectorOffRanges(const Pose2D& pose, std::array<double, 
     }
   }
   for (size_t s = 0; s < out.size(); ++s) {
-    if (!goal[s] && sector_bearing_reach_ < kStep) out[s] = far[s] * (1.0 + 1e-6) + 1e-6;
+    if (!goal[s]) out[s] = far[s] * (1.0 + 1e-6) + 1e-6;
   }
 }
 

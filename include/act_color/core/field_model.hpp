@@ -52,6 +52,9 @@ class FieldModel {
 
   double halfLength() const { return half_length_m_; }
   double halfWidth() const { return half_width_m_; }
+  // The carpet: the field plus margin (onCarpet).
+  double carpetHalfLength() const { return carpet_half_length_m_; }
+  double carpetHalfWidth() const { return carpet_half_width_m_; }
 
  private:
   FieldCalibration field_;
