@@ -58,6 +58,20 @@ void expectHolds(const sim::RealImageResult& r) {
   }
 }
 
+// Issue 13's 0.80 for the ball marked in ball.txt: recall, precision and the share of frames with
+// the ball reported inside the mark, before each change and after it.
+void expectBallMeetsIssue13(const sim::RealImageResult& r) {
+  ASSERT_FALSE(r.rows.empty());
+  for (const auto& row : r.rows) {
+    EXPECT_GE(row.before.ball_recall, 0.80) << row.variant;
+    EXPECT_GE(row.before.ball_precision, 0.80) << row.variant;
+    EXPECT_GE(row.before.ball_seen, 0.80) << row.variant;
+    EXPECT_GE(row.after.ball_recall, 0.80) << row.variant;
+    EXPECT_GE(row.after.ball_precision, 0.80) << row.variant;
+    EXPECT_GE(row.after.ball_seen, 0.80) << row.variant;
+  }
+}
+
 // formatRealImageTargets on hand-made results: what counts as meeting issue 12's targets.
 sim::RealVariantResult change(const std::string& variant, const std::string& mode, double white_before,
                               double white_after, double green_after, double hall_after, int back) {
@@ -161,38 +175,24 @@ TEST(RealImages, Nubot1BakBak) {
   const sim::RealImageResult r = run("nubot_1_bak_bak");
   expectHolds(r);
   // Issue 13 on a real camera: the yellow ball (marked by eye, ball.txt) is learned from the start
-  // image alone and reported where it is. What holds today, short of the issue's 0.80 recall
-  // (measured 0.61 before the change, precision 0.90, reported in 8 of the last 10 frames: seeded
-  // in the 12th frame, recall 0.70 from then on).
-  for (const auto& row : r.rows) {
-    EXPECT_GE(row.before.ball_recall, 0.5) << row.variant;
-    EXPECT_GE(row.before.ball_precision, 0.75) << row.variant;
-    EXPECT_GE(row.before.ball_seen, 0.8) << row.variant;
-    if (row.mode != "defaults" || row.variant != "darken") continue;
-    // After the paper's darkening the ball is found again: its colors, moved with the light, lay
-    // within the carpet's radius (zeta sigma_min at the least), and it was never seen again
-    // (recall 0.04, seen 0). Measured 0.69, precision 0.78, seen in all of the last 10 frames.
-    EXPECT_GE(row.after.ball_recall, 0.45);
-    EXPECT_GE(row.after.ball_seen, 0.8);
-  }
+  // image alone, reported where it is, and found again after every change, by the issue's 0.80
+  // (measured in the session of 2026-12-06 from 16:58: recall 0.95, precision 0.99, seen in 9 of
+  // the last 10 frames before the changes, seeded in the 12th; after them recall 0.94-0.98,
+  // precision 0.99-1.00, seen in all 10. Before the labelled image and the one-ball rule: 0.61 and
+  // 0.90 before; after the paper's darkening recall 0.04 and never seen, before the ball's colors
+  // moved with the light, then 0.69).
+  expectBallMeetsIssue13(r);
 }
 
 TEST(RealImages, Nubot2Ball) {
-  // Issue 13 on a second camera (another mirror, a monotone profile): its yellow ball (ball.txt) is
+  // Issue 13 on another image (480x480, another calibration folder): its yellow ball (ball.txt) is
   // learned from the start image and found again after every change, by the issue's 0.80 (measured
   // recall 0.96 and precision 0.98 before the changes, 0.85-0.98 and 0.95-1.00 after; seen in 9 of
   // the 10 frames before and all 10 after).
   const sim::RealImageResult r = run("nubot_2");
   ASSERT_TRUE(r.fitted) << r.why;
   ASSERT_EQ(r.rows.size(), sim::realImageVariants().size());
-  for (const auto& row : r.rows) {
-    EXPECT_GE(row.before.ball_recall, 0.80) << row.variant;
-    EXPECT_GE(row.before.ball_precision, 0.80) << row.variant;
-    EXPECT_GE(row.before.ball_seen, 0.80) << row.variant;
-    EXPECT_GE(row.after.ball_recall, 0.80) << row.variant;
-    EXPECT_GE(row.after.ball_precision, 0.80) << row.variant;
-    EXPECT_GE(row.after.ball_seen, 0.80) << row.variant;
-  }
+  expectBallMeetsIssue13(r);
 }
 
 }  // namespace
