@@ -11,6 +11,7 @@ ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
     : field_(calibration.field), camera_(calibration.camera) {
   ground_range_m_.resize(camera_.rays().size());
   removal_range_m_.resize(camera_.rays().size());
+  const double step = 2.0 * M_PI / kRemovalSectors;
   for (size_t i = 0; i < ground_range_m_.size(); ++i) {
     const PixelRay& ray = camera_.ray(i);
     ground_range_m_[i] = ray.region == PixelRegion::kFloor ? std::hypot(ray.ground_x_m, ray.ground_y_m)
@@ -18,12 +19,8 @@ ExpectedClassModel::ExpectedClassModel(const Calibration& calibration)
     const bool never_unknown = ray.region == PixelRegion::kNotImaged || ray.region == PixelRegion::kChassis ||
                                ray.region == PixelRegion::kSelf;
     removal_range_m_[i] = never_unknown ? -std::numeric_limits<float>::infinity() : ground_range_m_[i];
-  }
-  // How far the bearings of the floor points and above-horizon rays (which a tilt turns) reach
-  // beyond the sectors removalSector puts them in.
-  const double step = 2.0 * M_PI / kRemovalSectors;
-  for (size_t i = 0; i < ground_range_m_.size(); ++i) {
-    const PixelRay& ray = camera_.ray(i);
+    // How far the bearings of the floor points and above-horizon rays (which a tilt turns) reach
+    // beyond the sectors removalSector puts them in.
     if (ray.region != PixelRegion::kFloor && ray.region != PixelRegion::kAboveHorizon) continue;
     const double bearing = ray.region == PixelRegion::kFloor ? std::atan2(ray.ground_y_m, ray.ground_x_m)
                                                              : std::atan2(ray.dir_y, ray.dir_x);
