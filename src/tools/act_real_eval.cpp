@@ -3,16 +3,21 @@
 // (whites.txt): the camera calibration fitted to the image (as act_calibrate does: the field of a
 // preset or of a calibration file, the robot at a rough pose), then ACT from
 // that image at the fitted pose, and the image under five changes of light as 60-frame sequences
-// with fresh noise, for the defaults and the paper side by side.
+// with fresh noise, for the defaults and the paper side by side. A folder may hold its own setup
+// (act_real_eval.args: the image's name, the field, the rough pose, the height), over the command
+// line's.
 #include <dirent.h>
 #include <sys/stat.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
+#include <functional>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -30,8 +35,11 @@ void printUsage(std::ostream& out) {
          "                    [--preset lab6x4|msl2007 | --field CAL.yaml | --calibration CAL.yaml]\n"
          "                    [--pose x,y,theta] [--height-m H] [--set NAME=VALUE] [--png DIR] [--frames]\n"
          "  --dir DIR      every folder of DIR that holds the image\n"
-         "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels)\n"
-         "                 and CTableBGR.dat (NuBot's hand-made table, compared with ACT's)\n"
+         "  FOLDER         a folder with the image and, optionally, whites.txt (hand-picked line pixels),\n"
+         "                 CTableBGR.dat (NuBot's hand-made table, compared with ACT's) and\n"
+         "                 act_real_eval.args: options for this folder over the command line's (--image,\n"
+         "                 --preset, --field, --calibration, --pose, --height-m; files relative to the\n"
+         "                 folder; # starts a comment)\n"
          "  --image NAME   the image's file name in each folder (pic_save0.png)\n"
          "  --preset NAME  the field (lab6x4)\n"
          "  --field CAL.yaml  the field section of this calibration instead (your field)\n"
@@ -66,18 +74,102 @@ bool isFile(const std::string& path) {
   return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
+// What the evaluation of one folder needs besides the folder: from the command line, and from the
+// folder's act_real_eval.args over it.
+struct FolderSetup {
+  std::string image_name = "pic_save0.png";
+  // The field: at most one of a preset, a calibration's field section and a whole calibration.
+  std::string preset, field_path, calibration_path;
+  act_color::core::MirrorCalibratorOptions calibrator;
+  bool height_given = false;
+};
+
+// Applies `arg` (taking its value from `value`) to the setup; false when it is no folder option.
+// `fields` counts the field options given in one place (two are an error); a relative file name
+// is taken relative to `base` (empty: as given).
+bool applyFolderOption(const std::string& arg, const std::function<std::string()>& value, const std::string& base,
+                       FolderSetup* s, int* fields) {
+  auto path = [&](const std::string& name) {
+    return base.empty() || name.rfind('/', 0) == 0 ? name : base + "/" + name;
+  };
+  if (arg == "--image") {
+    s->image_name = value();
+  } else if (arg == "--preset" || arg == "--field" || arg == "--calibration") {
+    ++*fields;
+    s->preset.clear(), s->field_path.clear(), s->calibration_path.clear();
+    (arg == "--preset"  ? s->preset
+     : arg == "--field" ? s->field_path
+                        : s->calibration_path) = arg == "--preset" ? value() : path(value());
+  } else if (arg == "--pose") {
+    const auto p = act_color_tools::parseNumbers(value(), 3, arg);
+    s->calibrator.pose = {p[0], p[1], p[2]};
+  } else if (arg == "--height-m") {
+    s->calibrator.height_m = act_color_tools::parseNumber(value(), arg);
+    s->height_given = true;
+    if (!(s->calibrator.height_m > 0 && s->calibrator.height_m < 10)) {
+      throw std::invalid_argument("--height-m must be in (0, 10) m");
+    }
+  } else {
+    return false;
+  }
+  if (*fields > 1) throw std::invalid_argument("give one of --preset, --field and --calibration");
+  return true;
+}
+
+// The folder's act_real_eval.args over the command line's setup; throws naming the file.
+FolderSetup folderSetup(const std::string& folder, const FolderSetup& command_line) {
+  FolderSetup s = command_line;
+  const std::string file = folder + "/act_real_eval.args";
+  if (!isFile(file)) return s;
+  try {
+    std::ifstream in(file);
+    std::vector<std::string> words;
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream tokens(line.substr(0, line.find('#')));
+      for (std::string w; tokens >> w;) words.push_back(w);
+      if (words.size() > 64) throw std::invalid_argument("more than 64 words");
+    }
+    int fields = 0;
+    for (size_t i = 0; i < words.size(); ++i) {
+      auto value = [&]() -> std::string {
+        if (i + 1 >= words.size()) throw std::invalid_argument(words[i] + " needs a value");
+        return words[++i];
+      };
+      if (!applyFolderOption(words[i], value, folder, &s, &fields)) {
+        throw std::invalid_argument("'" + words[i] + "' is no option for a folder");
+      }
+    }
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(file + ": " + e.what());
+  }
+  return s;
+}
+
+// The field of a setup (a preset, a calibration's field) and the calibration to use as it is, if
+// one is given.
+void resolveField(const FolderSetup& s, act_color::core::FieldCalibration* field,
+                  std::optional<act_color::core::Calibration>* calibration) {
+  calibration->reset();
+  if (!s.calibration_path.empty()) {
+    if (s.height_given) throw std::invalid_argument("--height-m is the calibration's with --calibration");
+    *calibration = act_color::core::loadCalibration(s.calibration_path);
+    *field = (*calibration)->field;
+  } else {
+    *field = s.field_path.empty() ? act_color::core::fieldPreset(s.preset.empty() ? "lab6x4" : s.preset)
+                                  : act_color::core::loadCalibration(s.field_path).field;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> folders;
-  std::string dir, png_dir, image_name = "pic_save0.png", preset, field_path, calibration_path;
-  std::optional<act_color::core::Calibration> calibration;
-  bool height_given = false;
-  act_color::core::MirrorCalibratorOptions calibrator;
-  act_color::core::FieldCalibration field;
+  std::string dir, png_dir;
+  FolderSetup command_line;
   bool frames = false;
   act_color::core::ActParams defaults;
   try {
+    int command_line_fields = 0;
     for (int i = 1; i < argc; ++i) {
       const std::string arg = argv[i];
       auto value = [&]() -> std::string {
@@ -89,23 +181,7 @@ int main(int argc, char** argv) {
         return 0;
       } else if (arg == "--dir") {
         dir = value();
-      } else if (arg == "--image") {
-        image_name = value();
-      } else if (arg == "--preset") {
-        preset = value();
-      } else if (arg == "--field") {
-        field_path = value();
-      } else if (arg == "--calibration") {
-        calibration_path = value();
-      } else if (arg == "--pose") {
-        const auto p = act_color_tools::parseNumbers(value(), 3, arg);
-        calibrator.pose = {p[0], p[1], p[2]};
-      } else if (arg == "--height-m") {
-        calibrator.height_m = act_color_tools::parseNumber(value(), arg);
-        height_given = true;
-        if (!(calibrator.height_m > 0 && calibrator.height_m < 10)) {
-          throw std::invalid_argument("--height-m must be in (0, 10) m");
-        }
+      } else if (applyFolderOption(arg, value, "", &command_line, &command_line_fields)) {  // applied
       } else if (arg == "--png") {
         png_dir = value();
       } else if (arg == "--frames") {
@@ -119,30 +195,29 @@ int main(int argc, char** argv) {
         folders.push_back(arg);
       }
     }
+    // The command line's field is checked before any folder is looked at.
+    {
+      act_color::core::FieldCalibration field;
+      std::optional<act_color::core::Calibration> calibration;
+      resolveField(command_line, &field, &calibration);
+    }
     if (!dir.empty()) {
       DIR* d = opendir(dir.c_str());
       if (!d) throw std::invalid_argument(dir + ": cannot be read");
       std::vector<std::string> names;
       while (dirent* e = readdir(d)) {
         const std::string name = e->d_name;
-        if (name != "." && name != ".." && isFile(dir + "/" + name + "/" + image_name)) names.push_back(name);
+        if (name != "." && name != "..") names.push_back(name);
       }
       closedir(d);
       std::sort(names.begin(), names.end());
-      for (const auto& n : names) folders.push_back(dir + "/" + n);
+      for (const auto& n : names) {
+        const std::string folder = dir + "/" + n;
+        if (!isFile(folder + "/act_real_eval.args") && !isFile(folder + "/" + command_line.image_name)) continue;
+        folders.push_back(folder);
+      }
     }
-    if (folders.empty()) throw std::invalid_argument("no folder with " + image_name);
-    if (!preset.empty() + !field_path.empty() + !calibration_path.empty() > 1) {
-      throw std::invalid_argument("give one of --preset, --field and --calibration");
-    }
-    if (!calibration_path.empty()) {
-      if (height_given) throw std::invalid_argument("--height-m is the calibration's with --calibration");
-      calibration = act_color::core::loadCalibration(calibration_path);
-      field = calibration->field;
-    } else {
-      field = field_path.empty() ? act_color::core::fieldPreset(preset.empty() ? "lab6x4" : preset)
-                                 : act_color::core::loadCalibration(field_path).field;
-    }
+    if (folders.empty()) throw std::invalid_argument("no folder with " + command_line.image_name);
   } catch (const std::exception& e) {
     std::cerr << "act_real_eval: " << e.what() << "\n";
     printUsage(std::cerr);
@@ -154,10 +229,19 @@ int main(int argc, char** argv) {
   std::vector<act_color::sim::RealImageResult> results;
   for (const std::string& folder : folders) {
     act_color::sim::RealImage image;
+    FolderSetup setup;
+    try {
+      setup = folderSetup(folder, command_line);
+      resolveField(setup, &image.field, &image.calibration);
+    } catch (const std::exception& e) {
+      std::cerr << "act_real_eval: " << e.what() << "\n";
+      return 1;
+    }
+    if (!dir.empty() && !isFile(folder + "/" + setup.image_name)) continue;  // a folder of no image
     const size_t slash = folder.find_last_of('/');
-    image.name = (slash == std::string::npos ? folder : folder.substr(slash + 1)) + "/" + image_name;
+    image.name = (slash == std::string::npos ? folder : folder.substr(slash + 1)) + "/" + setup.image_name;
     std::string error;
-    if (!act_color::core::readImageFile(folder + "/" + image_name, cv::IMREAD_COLOR,
+    if (!act_color::core::readImageFile(folder + "/" + setup.image_name, cv::IMREAD_COLOR,
                                         act_color::core::kMaxImageFileBytes, act_color::core::kMaxImageSidePx,
                                         act_color::core::kMaxImagePixels, &image.bgr, &error)) {
       std::cerr << "act_real_eval: " << error << "\n";
@@ -172,9 +256,7 @@ int main(int argc, char** argv) {
     image.nubot_table = act_color::sim::readNubotTable(folder + "/CTableBGR.dat");
     act_color::sim::BallMark ball;
     if (act_color::sim::readBallMark(folder + "/ball.txt", &ball)) image.ball = ball;
-    image.field = field;
-    image.calibrator = calibrator;
-    image.calibration = calibration;
+    image.calibrator = setup.calibrator;
     results.push_back(act_color::sim::evaluateRealImage(image, modes));
     const auto& r = results.back();
     if (!png_dir.empty() && !r.labels_before.empty()) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -34,29 +35,37 @@ TEST(ActRealEval, RunsOnAnImageOfYourFieldWithYourCalibration) {
   cv::Mat bgr;
   cv::cvtColor(sim::Renderer(scene.calibration, scene.renderer).render(scene.scenario.frames.front().scene).rgb, bgr,
                cv::COLOR_RGB2BGR);
-  const std::string folder = tempDir() + "/our_robot", field = tempDir() + "/our_field.yaml";
+  const std::string robots = tempDir() + "/robots";
+  const std::string folder = robots + "/our_robot", field = robots + "/our_field.yaml";
   const std::string png = tempDir() + "/png";
+  ASSERT_EQ(mkdir(robots.c_str(), 0755), 0);
   ASSERT_EQ(mkdir(folder.c_str(), 0755), 0);
   ASSERT_EQ(mkdir(png.c_str(), 0755), 0);
   ASSERT_TRUE(cv::imwrite(folder + "/pic_save0.png", bgr));
+  ASSERT_TRUE(cv::imwrite(folder + "/at_the_corner.png", bgr));
   std::ofstream(field) << core::toYaml(scene.calibration);
   const core::Pose2D pose = scene.scenario.frames.front().scene.robot_pose;
   // Rough, as a team knows it: 0.2 m off.
   const std::string pose_arg =
       std::to_string(pose.x_m + 0.2) + "," + std::to_string(pose.y_m) + "," + std::to_string(pose.theta_rad);
-  const act_color_tool_test::ToolRun r = run(folder + " --field " + field + " --pose " + pose_arg + " --height-m " +
-                                             std::to_string(scene.calibration.camera.height_m) + " --png " + png);
+  // The folder's own setup (act_real_eval.args) over the command line's: another image, the field
+  // file beside it, the pose and the height; --dir finds the folder by it.
+  std::ofstream(folder + "/act_real_eval.args")
+      << "# our robot at the corner\n--image at_the_corner.png --field ../our_field.yaml\n--pose " << pose_arg
+      << "\n--height-m " << scene.calibration.camera.height_m << "\n";
+  const act_color_tool_test::ToolRun r = run("--dir " + robots + " --preset lab6x4 --pose 0,0,0 --png " + png);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("our_robot/pic_save0.png: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("our_robot/at_the_corner.png: "), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("not fitted"), std::string::npos) << r.output;
   for (const std::string& variant : sim::realImageVariants()) {
     EXPECT_NE(r.output.find("| " + variant + " | defaults | - | - | "), std::string::npos) << variant << r.output;
     EXPECT_NE(r.output.find("| " + variant + " | paper | "), std::string::npos) << variant;
-    const cv::Mat shown = cv::imread(png + "/our_robot_pic_save0_" + variant + ".png");
+    const cv::Mat shown = cv::imread(png + "/our_robot_at_the_corner_" + variant + ".png");
     EXPECT_EQ(shown.cols, 2 * bgr.cols) << variant;  // the image beside its classes
     EXPECT_EQ(shown.rows, bgr.rows) << variant;
   }
-  EXPECT_FALSE(cv::imread(png + "/our_robot_pic_save0_classified.png").empty());
+  EXPECT_FALSE(cv::imread(png + "/our_robot_at_the_corner_classified.png").empty());
+  ASSERT_EQ(std::remove((folder + "/act_real_eval.args").c_str()), 0);
 
   // The calibration file act_calibrate wrote for the camera (here: the truth), the robot where it is.
   const std::string exact =
@@ -78,6 +87,14 @@ TEST(ActRealEval, RefusesWhatItCannotUse) {
   EXPECT_EQ(run(folder + " --height-m -1").exit_code, 2);
   EXPECT_EQ(run(folder + " --bogus").exit_code, 2);
   EXPECT_EQ(run(tempDir() + "/no_such_folder").exit_code, 1);
+  // A folder's setup file with what is no folder option, or two fields: refused, naming the file.
+  for (const char* setup : {"--png /tmp", "--pose 1,2", "--preset lab6x4 --preset msl2007", "--image"}) {
+    std::ofstream(folder + "/act_real_eval.args") << setup << "\n";
+    const act_color_tool_test::ToolRun r = run(folder);
+    EXPECT_EQ(r.exit_code, 1) << setup;
+    EXPECT_NE(r.output.find("refused/act_real_eval.args: "), std::string::npos) << setup << r.output;
+  }
+  std::remove((folder + "/act_real_eval.args").c_str());
   // A calibration comes with its field and camera height.
   const std::string cal = tempDir() + "/other_camera.yaml";
   core::Calibration other = sim::makeFamilyScene(1003u, sim::ScenarioLength::kSmall, false).calibration;
