@@ -96,10 +96,16 @@ bool applyFolderOption(const std::string& arg, const std::function<std::string()
     s->image_name = value();
   } else if (arg == "--preset" || arg == "--field" || arg == "--calibration") {
     ++*fields;
-    s->preset.clear(), s->field_path.clear(), s->calibration_path.clear();
-    (arg == "--preset"  ? s->preset
-     : arg == "--field" ? s->field_path
-                        : s->calibration_path) = arg == "--preset" ? value() : path(value());
+    s->preset.clear();
+    s->field_path.clear();
+    s->calibration_path.clear();
+    if (arg == "--preset") {
+      s->preset = value();
+    } else if (arg == "--field") {
+      s->field_path = path(value());
+    } else {
+      s->calibration_path = path(value());
+    }
   } else if (arg == "--pose") {
     const auto p = act_color_tools::parseNumbers(value(), 3, arg);
     s->calibrator.pose = {p[0], p[1], p[2]};
@@ -117,17 +123,21 @@ bool applyFolderOption(const std::string& arg, const std::function<std::string()
 }
 
 // The folder's act_real_eval.args over the command line's setup; throws naming the file.
+constexpr off_t kMaxFolderSetupBytes = 4096;
 FolderSetup folderSetup(const std::string& folder, const FolderSetup& command_line) {
   FolderSetup s = command_line;
   const std::string file = folder + "/act_real_eval.args";
   if (!isFile(file)) return s;
   try {
+    struct stat st {};
+    if (stat(file.c_str(), &st) != 0 || st.st_size > kMaxFolderSetupBytes) {
+      throw std::invalid_argument("larger than " + std::to_string(kMaxFolderSetupBytes) + " bytes");
+    }
     std::ifstream in(file);
     std::vector<std::string> words;
     for (std::string line; std::getline(in, line);) {
       std::istringstream tokens(line.substr(0, line.find('#')));
       for (std::string w; tokens >> w;) words.push_back(w);
-      if (words.size() > 64) throw std::invalid_argument("more than 64 words");
     }
     int fields = 0;
     for (size_t i = 0; i < words.size(); ++i) {

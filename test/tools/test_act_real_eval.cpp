@@ -88,7 +88,10 @@ TEST(ActRealEval, RefusesWhatItCannotUse) {
   EXPECT_EQ(run(folder + " --bogus").exit_code, 2);
   EXPECT_EQ(run(tempDir() + "/no_such_folder").exit_code, 1);
   // A folder's setup file with what is no folder option, or two fields: refused, naming the file.
-  for (const char* setup : {"--png /tmp", "--pose 1,2", "--preset lab6x4 --preset msl2007", "--image"}) {
+  const std::string long_comment = "#" + std::string(5000, 'x');
+  for (const std::string& setup :
+       {std::string("--png /tmp"), std::string("--pose 1,2"), std::string("--preset lab6x4 --preset msl2007"),
+        std::string("--image"), long_comment}) {
     std::ofstream(folder + "/act_real_eval.args") << setup << "\n";
     const act_color_tool_test::ToolRun r = run(folder);
     EXPECT_EQ(r.exit_code, 1) << setup;
