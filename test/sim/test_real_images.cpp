@@ -32,8 +32,20 @@ sim::RealImageResult run(const std::string& folder) {
 void expectHolds(const sim::RealImageResult& r) {
   ASSERT_TRUE(r.fitted) << r.why;
   EXPECT_LT(r.fit.residual.median_m, 0.05);
+  // The team's hand-picked line pixels lie on the fitted model's lines (measured 1.00 on nubot_1
+  // and nubot_1_bak_bak), and the report says so without a warning.
+  EXPECT_GE(r.whites_on_lines, 0.9);
   ASSERT_EQ(r.rows.size(), sim::realImageVariants().size());
-  std::printf("%s", sim::formatRealImageReport({r}).c_str());
+  const std::string report = sim::formatRealImageReport({r});
+  std::printf("%s", report.c_str());
+  EXPECT_NE(report.find("% within 0.08 m of the model's lines)"), std::string::npos) << report;
+  EXPECT_EQ(report.find("another image"), std::string::npos) << report;
+  // Pixels picked on another image (nubot_2014's whites.txt beside its pic_save0): warned of.
+  sim::RealImageResult other = r;
+  other.whites_on_lines = 0.12;
+  EXPECT_NE(sim::formatRealImageReport({other}).find("(12% within 0.08 m of the model's lines: picked on another "
+                                                     "image or another field?)"),
+            std::string::npos);
   for (const auto& row : r.rows) {
     // Before the change: the targets.
     EXPECT_GE(row.before.white_recall, 0.50) << row.variant;
