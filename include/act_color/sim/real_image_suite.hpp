@@ -97,7 +97,7 @@ struct RealImageResult {
   core::MirrorFit fit;
   size_t whites = 0;  // hand-picked line pixels inside the image
   // Of them, the fraction within 0.08 m of the fitted model's lines (MirrorCalibrator::residual's
-  // inliers, as act_calibrate --whites measures them); -1 without any.
+  // inliers, as act_calibrate --whites measures them; the report warns below half); -1 without any.
   double whites_on_lines = -1;
   // The own robot's parts learned from the image (core::SelfMaskLearner), row-major.
   std::vector<uint8_t> self_mask;
@@ -111,11 +111,6 @@ struct RealImageResult {
   double nubot_black_agreement = -1;
   std::vector<RealVariantResult> rows;
 };
-
-// Below this fraction of the hand-picked pixels on the model's lines the report warns that they may
-// be of another image (the calibrator holds 0.85-1.00 of the team's pixels on the images they were
-// picked on).
-constexpr double kWhitesOnLinesWarning = 0.5;
 
 // The named variants, in order: "gain_0.5", "darken", "gamma_1.6", "warm_white_balance", "brighten",
 // "wrong_pose".
