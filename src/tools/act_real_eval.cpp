@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
@@ -123,17 +122,17 @@ bool applyFolderOption(const std::string& arg, const std::function<std::string()
 }
 
 // The folder's act_real_eval.args over the command line's setup; throws naming the file.
-constexpr off_t kMaxFolderSetupBytes = 4096;
+constexpr size_t kMaxFolderSetupBytes = 4096;
 FolderSetup folderSetup(const std::string& folder, const FolderSetup& command_line) {
   FolderSetup s = command_line;
   const std::string file = folder + "/act_real_eval.args";
   if (!isFile(file)) return s;
   try {
-    struct stat st {};
-    if (stat(file.c_str(), &st) != 0 || st.st_size > kMaxFolderSetupBytes) {
-      throw std::invalid_argument("larger than " + std::to_string(kMaxFolderSetupBytes) + " bytes");
+    std::string bytes, error;
+    if (!act_color::core::readRegularFile(file, kMaxFolderSetupBytes, &bytes, &error, "a folder's setup")) {
+      throw std::invalid_argument(error);
     }
-    std::ifstream in(file);
+    std::istringstream in(bytes);
     std::vector<std::string> words;
     for (std::string line; std::getline(in, line);) {
       std::istringstream tokens(line.substr(0, line.find('#')));
