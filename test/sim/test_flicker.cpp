@@ -72,33 +72,30 @@ TEST_F(Flicker, LightThatComesAndGoesLeavesTheTableAsItWas) {
   }
 }
 
-// An exposure controller hunting: 1 +- 0.3 at 2 Hz (30 frames per second). Under a light of its own
-// the table is larger (a steady run at 1.3 fills about twice the cells of one at 0.7), so the fill
-// is compared with the largest of steady runs at 0.7, 1 and 1.3; precision on the frames near 1
-// with the steady run at 1. Measured (bac65db): fill x1.24, precision within 0.048 (white: 0.868
-// against 0.916; yellow 0.873 against 0.900): white is 0.002 from the limit. Before a
-// moved table left the old light's cells behind and a change was taken at 0.4 instead of 0.75 of
-// green's sigma: fill x1.37, white precision 0.76 against 0.86.
-TEST_F(Flicker, AnExposureSwingingToAndFroLeavesTheTableAsItWas) {
-  const size_t n = frames.frames.size();
-  const std::vector<double> gains = sim::exposureSwing(n, 10, 0.3, 2.0);
+// An exposure controller hunting: 1 +- 0.3 at 2 Hz (30 frames per second), measured as act_flicker
+// measures it (its run "seed 0, exposure 1 +- 0.3 at 2 Hz"): every frame from the 30th against the
+// steady run at the nearest of 0.7, 0.725, ... 1.3, the compared frames pooled; every class's
+// precision within 0.03 (issue 15, item 1) and the fill within 1.5x. Measured (d065414): yellow
+// 0.025 below (0.888 against 0.913), fill x1.26. Until 2026-12-07 this test compared the frames
+// within 0.05 of exposure 1 (at 1.024 and 1.038) with the steady run at 1, allowing 0.05: yellow stood
+// at 0.0498 below (0.850 against 0.900; bac65db: 0.027, white 0.048), so that a change of the
+// trainer that left act_flicker's figures as they were moved it across. Before a moved table left the
+// old light's cells behind and a change was taken at 0.4 instead of 0.75 of green's sigma: fill x1.37,
+// white precision 0.76 against 0.86.
+TEST(FlickerHunting, AnExposureSwingingToAndFroLeavesTheTableAsItWas) {
+  const sim::FamilyScene scene = sim::makeFamilyScene(0, sim::ScenarioLength::kSmall, false);
+  const sim::FlickerFrames frames = sim::steadyLightFrames(scene, 120);
+  const std::vector<double> gains = sim::exposureSwing(frames.frames.size(), 10, 0.3, 2.0);
+  const std::vector<sim::FlickerRun> references = sim::playSteadyReferences(scene, frames, core::ActParams(), &gains);
   const sim::FlickerRun run = sim::playWithGains(scene, frames, gains);
-  const Measured flicker = measure(run, gains);
-  double largest_steady = 0;
-  Measured at_one;
-  for (const double gain : {0.7, 1.0, 1.3}) {
-    const std::vector<double> steady_gains(n, gain);
-    const Measured steady = measure(sim::playWithGains(scene, frames, steady_gains), std::vector<double>(n, 1.0));
-    largest_steady = std::max(largest_steady, steady.fill_mean);
-    if (gain == 1.0) at_one = steady;
-  }
-  std::printf("exposure 1 +- 0.3 at 2 Hz: fill max %.4f (largest steady mean %.4f: x%.2f), %d changes, %d restores\n",
-              flicker.fill_max, largest_steady, flicker.fill_max / largest_steady, run.light_changes, run.restores);
-  EXPECT_LE(flicker.fill_max, 1.5 * largest_steady);
+  const sim::FlickerComparison c = sim::compareWithSteadyLight(run, gains, references, 30);
+  std::printf("scene 0, exposure 1 +- 0.3 at 2 Hz: fill x%.2f, %d changes, %d restores\n", c.fill_max_ratio,
+              run.light_changes, run.restores);
+  EXPECT_LE(c.fill_max_ratio, 1.5);
   for (const int k : core::trainableClasses()) {
-    std::printf("  %-6s precision near exposure 1 %.3f (steady run %.3f)\n", core::className(k),
-                flicker.steady_light.precision(k), at_one.steady_light.precision(k));
-    EXPECT_GE(flicker.steady_light.precision(k), at_one.steady_light.precision(k) - 0.05) << core::className(k);
+    std::printf("  %-6s precision %.3f (steady runs %.3f)\n", core::className(k), c.run.precision(k),
+                c.reference.precision(k));
+    EXPECT_GE(c.run.precision(k), c.reference.precision(k) - 0.03) << core::className(k);
   }
 }
 
