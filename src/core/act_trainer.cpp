@@ -62,6 +62,25 @@ constexpr double kLightChangeMinShift = 5.0;
 // more in 15 segments and down in 3 (session of 2026-12-06 from 06:30, docs/experiments.md).
 constexpr double kMajorityEvidenceRatio = 1.0;
 
+// The lines' margin depends on the light. Bright lines (their cluster's mean at least
+// kBrightLinesLevel per channel, of 255) stand far from the carpet and the hall's greys, and their
+// blurred edges fill few cells the hall shares: a color of theirs the hall shows more than
+// kBrightLinesEvidenceRatio times as often is the hall's. Not near saturation (a channel at
+// kNearlyClippedValue or more), where a line and a lamp become one color again, and not under a
+// darker light, where the colors are packed closer and the lines share more cells with the hall:
+// there they keep ActParams::evidence_removal_ratio. Against a ratio of 3 throughout, tuning split:
+// white F1 up by 0.02 or more in 13 segments, down in none (blue and black down in one each). At
+// 1.5 for lines under any light (27 up, 6 down), the real images' white came back after gain 0.5 in
+// 36-38 cycles or never instead of 5-20, after the paper's darkening never (nubot_1,
+// nubot_1_bak_bak). At 1.5 for bright lines' near-saturated colors too (17 up, 1 down), white fell to
+// 0.21 / 0.32 / 0.16 after the 1.5x brightening on nubot_1 / nubot_2 / nubot_1_bak_bak, for good.
+// With colors from 240 on clipped instead (ratio 5, every class): 13 up, 4 down, the ball's F1 down
+// in 7 fresh segments. The level at 125 instead of 150: 17 up, 5 down (with that clipping), but a
+// gain of 0.5 takes saturated lines to 128 (session of 2026-12-06 from 22:08, docs/experiments.md).
+constexpr double kBrightLinesLevel = 150.0;
+constexpr double kBrightLinesEvidenceRatio = 1.5;
+constexpr uint8_t kNearlyClippedValue = 240;
+
 // A channel at or above this value is clipped. A saturated line and a saturated window or lamp are
 // the same color: a clipped color is removed on the evidence rule (and kept from being added again)
 // only when it is seen off the field this many times as often as in the field (at least
@@ -637,6 +656,10 @@ double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
   if (k == kOrange) return majority;  // clipped or not
   if (clipped(c)) return std::max(params_.evidence_removal_ratio, kClippedEvidenceRatio);
   if (k == kGreen || k == kYellow || k == kBlue) return majority;
+  if (k == kWhite && std::max({c[0], c[1], c[2]}) < kNearlyClippedValue &&
+      intensity(clusters_[kWhite].mean()) >= 3.0 * kBrightLinesLevel) {
+    return std::min(params_.evidence_removal_ratio, kBrightLinesEvidenceRatio);
+  }
   return params_.evidence_removal_ratio;
 }
 
