@@ -38,6 +38,23 @@ Measured measure(const sim::FlickerRun& run, const std::vector<double>& gains) {
   return m;
 }
 
+// A family scene's exposure swinging 1 +- 0.3 at `hz` over 120 frames, measured as act_flicker
+// measures it: every frame from the 30th against the steady run nearest its light.
+struct Swing {
+  sim::FlickerRun run;
+  sim::FlickerComparison compared;
+};
+Swing swingAgainstSteadyLight(uint32_t seed, double hz) {
+  const sim::FamilyScene scene = sim::makeFamilyScene(seed, sim::ScenarioLength::kSmall, false);
+  const sim::FlickerFrames frames = sim::steadyLightFrames(scene, 120);
+  const std::vector<double> gains = sim::exposureSwing(frames.frames.size(), 10, 0.3, hz);
+  const std::vector<sim::FlickerRun> references = sim::playSteadyReferences(scene, frames, core::ActParams(), &gains);
+  Swing s;
+  s.run = sim::playWithGains(scene, frames, gains);
+  s.compared = sim::compareWithSteadyLight(s.run, gains, references, 30);
+  return s;
+}
+
 class Flicker : public ::testing::Test {
  protected:
   void SetUp() override { frames = sim::steadyLightFrames(scene, 60); }
@@ -83,14 +100,10 @@ TEST_F(Flicker, LightThatComesAndGoesLeavesTheTableAsItWas) {
 // old light's cells behind and a change was taken at 0.4 instead of 0.75 of green's sigma: fill x1.37,
 // white precision 0.76 against 0.86.
 TEST(FlickerHunting, AnExposureSwingingToAndFroLeavesTheTableAsItWas) {
-  const sim::FamilyScene scene = sim::makeFamilyScene(0, sim::ScenarioLength::kSmall, false);
-  const sim::FlickerFrames frames = sim::steadyLightFrames(scene, 120);
-  const std::vector<double> gains = sim::exposureSwing(frames.frames.size(), 10, 0.3, 2.0);
-  const std::vector<sim::FlickerRun> references = sim::playSteadyReferences(scene, frames, core::ActParams(), &gains);
-  const sim::FlickerRun run = sim::playWithGains(scene, frames, gains);
-  const sim::FlickerComparison c = sim::compareWithSteadyLight(run, gains, references, 30);
+  const Swing swing = swingAgainstSteadyLight(0, 2.0);
+  const sim::FlickerComparison& c = swing.compared;
   std::printf("scene 0, exposure 1 +- 0.3 at 2 Hz: fill x%.2f, %d changes, %d restores\n", c.fill_max_ratio,
-              run.light_changes, run.restores);
+              swing.run.light_changes, swing.run.restores);
   EXPECT_LE(c.fill_max_ratio, 1.5);
   for (const int k : core::trainableClasses()) {
     std::printf("  %-6s precision %.3f (steady runs %.3f)\n", core::className(k), c.run.precision(k),
@@ -132,12 +145,7 @@ TEST(FlickerSlowSwing, AnExposureSwingingSlowlyIsServedByTheLightsItLeft) {
 // moved, and white fell 0.071 below; fitted with a curve of light's form, 0.015 (0.012 against
 // references every 0.025 of gain instead of 0.1).
 TEST(FlickerFastSwing, AnExposureAlternatingEveryFrameKeepsThePrecision) {
-  const sim::FamilyScene scene = sim::makeFamilyScene(5, sim::ScenarioLength::kSmall, false);
-  const sim::FlickerFrames frames = sim::steadyLightFrames(scene, 120);
-  const std::vector<double> gains = sim::exposureSwing(frames.frames.size(), 10, 0.3, 15.0);
-  const std::vector<sim::FlickerRun> references = sim::playSteadyReferences(scene, frames, core::ActParams(), &gains);
-  const sim::FlickerComparison c =
-      sim::compareWithSteadyLight(sim::playWithGains(scene, frames, gains), gains, references, 30);
+  const sim::FlickerComparison c = swingAgainstSteadyLight(5, 15.0).compared;
   std::printf("scene 5, exposure 1 +- 0.3 at 15 Hz: worst precision drop %.3f (%s), fill x%.2f\n",
               c.worst_precision_drop, core::className(c.worst_class), c.fill_max_ratio);
   EXPECT_LE(c.worst_precision_drop, 0.03) << core::className(c.worst_class);
