@@ -7,6 +7,7 @@
 #include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "act_color/core/segmenter.hpp"
 #include "act_color/core/table_ceiling.hpp"
@@ -34,7 +35,7 @@ void writePanel(const std::string& path, const cv::Mat& rgb, const std::vector<c
   cv::Mat row;
   cv::hconcat(panels, row);
   cv::cvtColor(row, row, cv::COLOR_RGB2BGR);
-  cv::imwrite(path, row);
+  if (!cv::imwrite(path, row)) throw std::runtime_error("cannot write " + path);
 }
 
 // Segments that start with a sudden change of light, global or local (settle cycles are measured

@@ -7,6 +7,7 @@
 // Tune on the tuning split (seeds 0-99); the report split (1000-1099) is for reporting only.
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -35,6 +36,7 @@ const char* const kUsage =
     "  --mode M:N=V,N=V  one more mode: the defaults with these parameters (repeatable)\n"
     "  --per-scene   one line per scene and segment: F1 per class and mode, [ceiling]\n"
     "  --png DIR     input | labels of each mode | truth, for the last frame of every segment\n"
+    "                (scene_SSSSS_frame_FFF.png; DIR is made if missing)\n"
     "  --false-pixels  also where each class's false pixels lie: in cells the ceiling gives the class\n"
     "                too, in the hall's cells, in other classes' cells; clipped (slower)\n";
 
@@ -135,12 +137,25 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     return usage(e.what());
   }
+  if (!options.png_dir.empty()) {
+    std::error_code error;
+    std::filesystem::create_directories(options.png_dir, error);
+    if (!std::filesystem::is_directory(options.png_dir)) {
+      return usage("--png: cannot make the folder " + options.png_dir +
+                   (error ? " (" + error.message() + ")" : std::string(" (not a folder)")));
+    }
+  }
   std::vector<sim::SceneResult> results;
   double render = 0, act = 0;
   size_t frames = 0;
   for (uint32_t seed = first; seed < end; ++seed) {
     const sim::FamilyScene scene = sim::makeFamilyScene(seed, length, true, light_events);
-    results.push_back(sim::evaluateScene(scene, modes, options));
+    try {
+      results.push_back(sim::evaluateScene(scene, modes, options));
+    } catch (const std::runtime_error& e) {
+      std::cerr << "act_eval: " << e.what() << "\n";
+      return 1;
+    }
     render += results.back().render_seconds;
     act += results.back().act_seconds;
     frames += results.back().frames;

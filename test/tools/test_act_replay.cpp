@@ -540,6 +540,19 @@ TEST(ActEval, OneSceneReportAndFamilyBag) {
   std::ifstream local_in(local);
   const std::string local_text((std::istreambuf_iterator<char>(local_in)), std::istreambuf_iterator<char>());
   EXPECT_NE(local_text.find("segment 'local:"), std::string::npos) << local_text;
+  // --png makes its folder; one that cannot be made is an error before any scene is run.
+  const std::string png = tempDir() + "/eval_png/nested";
+  ASSERT_EQ(std::system((eval + " --seeds 0-0 --png " + png + " > /dev/null 2>&1").c_str()), 0);
+  size_t panels = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(png)) {
+    panels += entry.path().filename().string().rfind("scene_00000_frame_", 0) == 0;
+  }
+  EXPECT_GE(panels, 1u);
+  const std::string png_error = tempDir() + "/eval_png_error.txt";
+  EXPECT_EQ(WEXITSTATUS(std::system((eval + " --seeds 0-0 --png " + out + "/png 2> " + png_error).c_str())), 2);
+  std::ifstream png_error_in(png_error);
+  const std::string png_error_text((std::istreambuf_iterator<char>(png_error_in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(png_error_text.find("--png: cannot make the folder " + out + "/png"), std::string::npos) << png_error_text;
   EXPECT_EQ(WEXITSTATUS(std::system((eval + " --split nonsense 2> /dev/null").c_str())), 2);
   EXPECT_EQ(WEXITSTATUS(std::system((eval + " --set zeta=-1 2> /dev/null").c_str())), 2);
 
