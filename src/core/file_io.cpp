@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <vector>
 
@@ -46,6 +47,15 @@ bool readRegularFile(const std::string& path, size_t max_bytes, std::string* byt
   ::close(fd);
   bytes->resize(done);
   return true;
+}
+
+bool makeFolder(const std::string& path, std::string* error) {
+  std::error_code made;
+  std::filesystem::create_directories(path, made);
+  std::error_code is;
+  if (std::filesystem::is_directory(path, is)) return true;
+  *error = path + ": cannot make the folder (" + (made ? made.message() : std::string("not a folder")) + ")";
+  return false;
 }
 
 bool writeFileAtomically(const std::string& path, const void* data, size_t size, std::string* error) {

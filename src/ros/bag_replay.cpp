@@ -24,6 +24,7 @@
 #include <sstream>
 #include <vector>
 
+#include "act_color/core/file_io.hpp"
 #include "act_color/core/omni_camera_model.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/core/self_mask_learner.hpp"
@@ -64,7 +65,7 @@ void writeSideBySide(const std::string& path, const sensor_msgs::Image& image, c
   }
   cv::Mat out;
   cv::hconcat(panels, out);
-  cv::imwrite(path, out);
+  if (!cv::imwrite(path, out)) throw ReplayError(path + ": cannot be written");
 }
 
 std::string topicList(const rosbag::Bag& bag) {
@@ -378,6 +379,9 @@ ReplayResult runReplay(const ReplayOptions& options, std::ostream& log) {
   const core::Calibration calibration = core::loadCalibration(options.calibration);
   if (options.lut_every == 0) throw ReplayError("--lut-every must be at least 1");
   std::error_code ec;
+  if (std::string error; !options.png_dir.empty() && !core::makeFolder(options.png_dir, &error)) {
+    throw ReplayError("--png: " + error);
+  }
   if (std::filesystem::equivalent(options.input_bag, options.output_bag, ec)) {
     throw ReplayError(options.output_bag + ": is the input bag; choose another --output");
   }

@@ -7,12 +7,12 @@
 // Tune on the tuning split (seeds 0-99); the report split (1000-1099) is for reporting only.
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
 
 #include "act_color/core/act_trainer.hpp"
+#include "act_color/core/file_io.hpp"
 #include "act_color/sim/family_evaluation.hpp"
 #include "act_color/sim/scene_family.hpp"
 
@@ -137,13 +137,8 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     return usage(e.what());
   }
-  if (!options.png_dir.empty()) {
-    std::error_code error;
-    std::filesystem::create_directories(options.png_dir, error);
-    if (!std::filesystem::is_directory(options.png_dir)) {
-      return usage("--png: cannot make the folder " + options.png_dir +
-                   (error ? " (" + error.message() + ")" : std::string(" (not a folder)")));
-    }
+  if (std::string error; !options.png_dir.empty() && !core::makeFolder(options.png_dir, &error)) {
+    return usage("--png: " + error);
   }
   std::vector<sim::SceneResult> results;
   double render = 0, act = 0;

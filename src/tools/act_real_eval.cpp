@@ -48,7 +48,8 @@ void printUsage(std::ostream& out) {
          "                 0,0,0: on the centre spot facing +x, the yellow goal)\n"
          "  --height-m H   the camera's viewpoint height for the fit (default 0.7)\n"
          "  --png DIR      each image beside its classes (defaults) as PNGs: the frame before the change\n"
-         "                 (NAME_classified.png) and the last frame of each variant (NAME_VARIANT.png)\n"
+         "                 (NAME_classified.png) and the last frame of each variant (NAME_VARIANT.png);\n"
+         "                 DIR is made if missing\n"
          "  --set NAME=VALUE  an ActParams parameter of the defaults (repeatable; e.g. seed=2)\n"
          "  --frames       also every frame's white recall, green recall, hall in a field class, hall\n"
          "                 as black and hall as a goal (after the change from frame 21), per variant and\n"
@@ -227,6 +228,9 @@ int main(int argc, char** argv) {
       }
     }
     if (folders.empty()) throw std::invalid_argument("no folder with " + command_line.image_name);
+    if (std::string error; !png_dir.empty() && !act_color::core::makeFolder(png_dir, &error)) {
+      throw std::invalid_argument("--png: " + error);
+    }
   } catch (const std::exception& e) {
     std::cerr << "act_real_eval: " << e.what() << "\n";
     printUsage(std::cerr);

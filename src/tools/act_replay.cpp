@@ -37,7 +37,8 @@ void printUsage(std::ostream& out) {
          "  --adapt-frames N     frames after each event left out of the *_ad figures (default 12)\n"
          "  --csv FILE           per-frame recall and precision per class\n"
          "  --learn-self-mask F  learn the own robot's pixels (struts, cables) and write them to the PNG F\n"
-         "  --png DIR            input | classified | truth as PNG for every n-th frame (--png-every N, 10)\n"
+         "  --png DIR            input | classified | truth as PNG for every n-th frame (--png-every N, 10;\n"
+         "                       DIR is made if missing)\n"
          "  --no-progress        no progress lines on stderr\n"
          "  --brief              a short accuracy summary instead of the full report\n";
 }

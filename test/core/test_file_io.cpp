@@ -49,6 +49,23 @@ std::string calibrationError(const std::string& path) {
   return "";
 }
 
+// A tool's output folder: made with its parents, kept when it is there, refused under a file.
+TEST(FileIo, OutputFoldersAreMadeOrRefusedWithTheirName) {
+  std::string error;
+  const std::string nested = tempDir() + "/out/panels";
+  EXPECT_TRUE(core::makeFolder(nested, &error)) << error;
+  struct stat st {};
+  ASSERT_EQ(::stat(nested.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISDIR(st.st_mode));
+  EXPECT_TRUE(core::makeFolder(nested, &error)) << error;  // already there
+  const std::string file = tempDir() + "/a_file";
+  writeBytes(file, "x");
+  EXPECT_FALSE(core::makeFolder(file, &error));
+  EXPECT_NE(error.find(file + ": cannot make the folder"), std::string::npos) << error;
+  EXPECT_FALSE(core::makeFolder(file + "/below", &error));
+  EXPECT_NE(error.find(file + "/below: cannot make the folder"), std::string::npos) << error;
+}
+
 TEST(FileIo, OnlyBoundedRegularFilesAreRead) {
   std::string bytes, error;
   const std::string fifo = tempDir() + "/fifo";

@@ -37,10 +37,9 @@ TEST(ActRealEval, RunsOnAnImageOfYourFieldWithYourCalibration) {
                cv::COLOR_RGB2BGR);
   const std::string robots = tempDir() + "/robots";
   const std::string folder = robots + "/our_robot", field = robots + "/our_field.yaml";
-  const std::string png = tempDir() + "/png";
+  const std::string png = tempDir() + "/png/made";  // --png makes it
   ASSERT_EQ(mkdir(robots.c_str(), 0755), 0);
   ASSERT_EQ(mkdir(folder.c_str(), 0755), 0);
-  ASSERT_EQ(mkdir(png.c_str(), 0755), 0);
   ASSERT_TRUE(cv::imwrite(folder + "/pic_save0.png", bgr));
   ASSERT_TRUE(cv::imwrite(folder + "/at_the_corner.png", bgr));
   std::ofstream(field) << core::toYaml(scene.calibration);

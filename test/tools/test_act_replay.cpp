@@ -227,6 +227,15 @@ TEST(ActReplay, ClearErrorsForUnusableInput) {
   o = options(in, tempDir() + "/x.bag");
   o.calibration = "/nonexistent.yaml";
   EXPECT_NE(errorOf(o).find("/nonexistent.yaml"), std::string::npos);
+  // --png: the folder is made if missing; one that cannot be (under a file) is an error up front.
+  o = options(in, tempDir() + "/x.bag");
+  o.png_dir = tempDir() + "/replay_png/nested";
+  o.png_every = 16;
+  EXPECT_EQ(errorOf(o), "");
+  EXPECT_TRUE(exists(o.png_dir + "/frame_00000.png"));
+  EXPECT_TRUE(exists(o.png_dir + "/frame_00016.png"));
+  o.png_dir = junk + "/png";
+  EXPECT_NE(errorOf(o).find("--png: " + junk + "/png: cannot make the folder"), std::string::npos) << errorOf(o);
   // The executable: usage errors exit 2, unusable input 1.
   const std::string tool = std::string(ACT_TOOLS_DIR) + "/act_replay";
   EXPECT_EQ(WEXITSTATUS(std::system((tool + " --bag " + in + " 2> /dev/null").c_str())), 2);
@@ -552,7 +561,7 @@ TEST(ActEval, OneSceneReportAndFamilyBag) {
   EXPECT_EQ(WEXITSTATUS(std::system((eval + " --seeds 0-0 --png " + out + "/png 2> " + png_error).c_str())), 2);
   std::ifstream png_error_in(png_error);
   const std::string png_error_text((std::istreambuf_iterator<char>(png_error_in)), std::istreambuf_iterator<char>());
-  EXPECT_NE(png_error_text.find("--png: cannot make the folder " + out + "/png"), std::string::npos) << png_error_text;
+  EXPECT_NE(png_error_text.find("--png: " + out + "/png: cannot make the folder"), std::string::npos) << png_error_text;
   EXPECT_EQ(WEXITSTATUS(std::system((eval + " --split nonsense 2> /dev/null").c_str())), 2);
   EXPECT_EQ(WEXITSTATUS(std::system((eval + " --set zeta=-1 2> /dev/null").c_str())), 2);
 
