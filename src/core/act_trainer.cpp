@@ -63,8 +63,8 @@ constexpr double kLightChangeMinShift = 5.0;
 constexpr double kMajorityEvidenceRatio = 1.0;
 
 // The lines' margin depends on the light. Bright lines (their cluster's mean at least
-// kBrightLinesLevel per channel, of 255) stand far from the carpet and the hall's greys, and their
-// blurred edges fill few cells the hall shares: a color of theirs the hall shows more than
+// kBrightLinesLevel per channel on average, of 255: ActTrainer::intensity) stand far from the carpet and the hall's
+// greys, and their blurred edges fill few cells the hall shares: a color of theirs the hall shows more than
 // kBrightLinesEvidenceRatio times as often is the hall's. Not near saturation (a channel at
 // kNearlyClippedValue or more), where a line and a lamp become one color again, and not under a
 // darker light, where the colors are packed closer and the lines share more cells with the hall:
@@ -95,7 +95,7 @@ constexpr uint8_t kNearlyClippedValue = 240;
 constexpr uint8_t kClippedValue = 254;
 constexpr double kClippedEvidenceRatio = 5.0;
 
-bool clipped(const uint8_t c[3]) { return std::max({c[0], c[1], c[2]}) >= kClippedValue; }
+bool clipped(const uint8_t c[3], uint8_t from = kClippedValue) { return std::max({c[0], c[1], c[2]}) >= from; }
 
 // The change of light's own cycle and the ones after it, up to this many in all, add every
 // light_change_add_stride-th pixel. At one cycle, white took more than 2 cycles to settle after 51
@@ -656,7 +656,7 @@ double ActTrainer::evidenceRatio(uint8_t k, const uint8_t c[3]) const {
   if (k == kOrange) return majority;  // clipped or not
   if (clipped(c)) return std::max(params_.evidence_removal_ratio, kClippedEvidenceRatio);
   if (k == kGreen || k == kYellow || k == kBlue) return majority;
-  if (k == kWhite && std::max({c[0], c[1], c[2]}) < kNearlyClippedValue &&
+  if (k == kWhite && !clipped(c, kNearlyClippedValue) &&
       intensity(clusters_[kWhite].mean()) >= 3.0 * kBrightLinesLevel) {
     return std::min(params_.evidence_removal_ratio, kBrightLinesEvidenceRatio);
   }

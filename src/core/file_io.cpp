@@ -50,10 +50,9 @@ bool readRegularFile(const std::string& path, size_t max_bytes, std::string* byt
 }
 
 bool makeFolder(const std::string& path, std::string* error) {
-  std::error_code made;
+  std::error_code made, checked;  // the non-throwing overloads
   std::filesystem::create_directories(path, made);
-  std::error_code is;
-  if (std::filesystem::is_directory(path, is)) return true;
+  if (std::filesystem::is_directory(path, checked)) return true;
   *error = path + ": cannot make the folder (" + (made ? made.message() : std::string("not a folder")) + ")";
   return false;
 }

@@ -35,7 +35,7 @@ void writePanel(const std::string& path, const cv::Mat& rgb, const std::vector<c
   cv::Mat row;
   cv::hconcat(panels, row);
   cv::cvtColor(row, row, cv::COLOR_RGB2BGR);
-  if (!cv::imwrite(path, row)) throw std::runtime_error("cannot write " + path);
+  if (!cv::imwrite(path, row)) throw std::runtime_error(path + ": cannot be written");
 }
 
 // Segments that start with a sudden change of light, global or local (settle cycles are measured

@@ -22,9 +22,9 @@ bool readRegularFile(const std::string& path, size_t max_bytes, std::string* byt
 // with a message naming the file otherwise.
 bool writeFileAtomically(const std::string& path, const void* data, size_t size, std::string* error);
 
-// Makes the folder `path` and its parents when missing (a tool's output folder: written into a
-// folder that did not exist, images went nowhere, unsaid). False with a message naming the folder
-// when it cannot be made or is not a folder.
+// Makes the folder `path` and its parents when missing (a tool's output folder, which the tools'
+// image writes do not make). False with a message naming the folder when it cannot be made or is
+// not a folder.
 bool makeFolder(const std::string& path, std::string* error);
 
 // The width and height a PNG or JPEG file declares in its header, read without decoding; false for
