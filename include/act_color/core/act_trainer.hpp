@@ -302,7 +302,8 @@ class ActTrainer {
   // the state of each light recently left is kept, and a change back to one of them restores its
   // table, clusters and evidence instead of moving the table once more. Moving it to and fro would
   // spread every class a cell further with each round (the table filled to 98% under flicker).
-  // Returns true when it restored one (the state left is kept in its place).
+  // Returns true when it restored one (the state left is kept in its place). A restored light's
+  // cycle samples the frame kRestoredDensity times as densely (density_).
   bool restoreLightState();
   void keepLightState();
   // robots_train_black's intensity below which a color is dark, in this cycle's light.
@@ -427,6 +428,9 @@ class ActTrainer {
   std::unordered_map<int, int> sampling_strides_;
   int add_weight_ = 1;              // pixels one in-field sample stands for in this cycle
   uint64_t last_light_change_ = 0;  // revision_ + 1 of the last change of light; 0: none
+  // This cycle's sampling density of 2.3's additions, learned_boundary and 2.4's removal: 1, or
+  // kRestoredDensity in a restored light's cycle (each sample standing for as many fewer pixels).
+  int density_ = 1;
   // pose_check: true when this cycle is not to train (stats: contradiction, pose_contradicted).
   bool poseContradicted(CycleStats& stats);
   // The share of this cycle's cluster samples of green, white and the goals whose color the table
@@ -485,6 +489,7 @@ class ActTrainer {
   template <class Pixels>
   void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
   int removal_samples_stride_ = 0;
+  float removal_weight_ = 0.f;      // pixels one off-field sample stands for: the stride / density_
   uint32_t unclassed_samples_ = 0;  // removal samples of colors no class has, so far
   // Ball training.
   BallDetector ball_detector_;
