@@ -1212,7 +1212,6 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   // passes from random starts).
   for (int pass = 0; pass < density_; ++pass) {
     selectRemovalCandidates(randomStart(samplingStride(params_.remove_stride)));
-    removal_weight_ = static_cast<float>(removal_samples_stride_) / static_cast<float>(density_);
     withPixels(image, [&](const auto& pixels) { removeOffField(pixels, transform, stats); });
   }
   ++revision_;
@@ -1462,6 +1461,8 @@ bool ActTrainer::maybeRobot(int sector, float range_m, const Pixels& pixels) {
 
 template <class Pixels>
 void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats) {
+  // Pixels one off-field sample stands for: the samples' stride over this cycle's density.
+  const float weight = static_cast<float>(removal_samples_stride_) / static_cast<float>(density_);
   // |mu_k - c| > xi * sigma_k, compared as squared distances in float.
   std::array<Eigen::Vector3f, kNumClasses> remove_mean;
   std::array<float, kNumClasses> remove_radius_sq;
@@ -1502,7 +1503,7 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
         // kUnclassedSightingStride-th such sample counts, for that many.
         if (params_.evidence_removal_ratio > 0 && ++unclassed_samples_ % kUnclassedSightingStride == 0 && !clipped(c) &&
             !maybeRobot(sector, sample.range_m, pixels) && offField(sample)) {
-          evidence(cell).off_field += kUnclassedSightingStride * removal_weight_;
+          evidence(cell).off_field += kUnclassedSightingStride * weight;
         }
         continue;
       }
@@ -1516,7 +1517,7 @@ void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& trans
       const bool ball = k == kOrange;
       if (params_.evidence_removal_ratio > 0) {
         Evidence& e = evidence(cell);
-        e.off_field += removal_weight_;
+        e.off_field += weight;
         if (e.off_field >= static_cast<float>((ball ? 1 : kMinOffFieldSightings) * removal_samples_stride_) &&
             e.off_field > evidenceRatio(k, c) * e.in_field) {
           removeCell(cell);

@@ -489,7 +489,6 @@ class ActTrainer {
   template <class Pixels>
   void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
   int removal_samples_stride_ = 0;
-  float removal_weight_ = 0.f;      // pixels one off-field sample stands for: the stride / density_
   uint32_t unclassed_samples_ = 0;  // removal samples of colors no class has, so far
   // Ball training.
   BallDetector ball_detector_;
