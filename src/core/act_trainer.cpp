@@ -43,6 +43,8 @@ constexpr uint32_t kNeighbourhoodRefreshCycles = 8;
 // 0.03-0.11 below a steady run at the same light in 12 of 36 runs). A restored light's cycle
 // samples this many times as densely, each sample standing for as many fewer pixels.
 constexpr int kRestoredDensity = 4;
+// This cycle's sampling density of 2.3's additions, learned_boundary and 2.4's removal.
+int samplingDensity(const CycleStats& stats) { return stats.light_restored ? kRestoredDensity : 1; }
 
 // Chassis pixels the light model reads every cycle.
 constexpr size_t kChassisAnchorSamples = 192;
@@ -588,8 +590,9 @@ void ActTrainer::learnBoundary(const ImageView& image, const PoseTransform& tran
     return t0 + centre.dot(dir) + cell_reach;
   };
   // The start moves on each cycle (not drawn from rng_: the other steps' samples stay as they were).
-  const int stride = samplingStride(kBoundaryStride / density_);
-  const float count = 1.f / static_cast<float>(density_);
+  const int density = samplingDensity(stats);
+  const int stride = samplingStride(kBoundaryStride / density);
+  const float count = 1.f / static_cast<float>(density);
   for (StridedPixels p(static_cast<size_t>(revision_ * 7 % static_cast<uint64_t>(stride)), stride, width); p.i < pixels;
        p.next()) {
     uint8_t c[3];
@@ -1191,12 +1194,12 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   measureCarpetSpread();
   measureCarpetShade();
   markAbsentGoals(stats);
-  density_ = stats.light_restored ? kRestoredDensity : 1;
+  const int density = samplingDensity(stats);
   if (params_.learned_boundary && params_.nearest_mean) learnBoundary(image, transform, stats);
   // 2.3: add c -> k for colors within zeta * sigma_k of the cluster.
   if (stats.light_change) last_light_change_ = revision_ + 1;
   const int add_stride = denseAddCycle() ? std::min(params_.add_stride, params_.light_change_add_stride)
-                                         : std::max(1, params_.add_stride / density_);
+                                         : std::max(1, params_.add_stride / density);
   add_weight_ = samplingStride(add_stride);
   prepareNearestMean();
   dark_limit = darkLimit();  // of the clusters just moved
@@ -1213,9 +1216,9 @@ CycleStats ActTrainer::cycle(const ImageView& image, const Pose2D& pose) {
   model_.sectorOffRanges(pose, sector_off_range_);
   if (params_.ball_training) trainBall(image, transform, stats);
 
-  // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it (density_
-  // passes from random starts).
-  for (int pass = 0; pass < density_; ++pass) {
+  // 2.4: remove colors seen off the field from their class unless within xi * sigma_k of it (one
+  // pass from a random start per unit of density).
+  for (int pass = 0; pass < density; ++pass) {
     selectRemovalCandidates(randomStart(samplingStride(params_.remove_stride)));
     withPixels(image, [&](const auto& pixels) { removeOffField(pixels, transform, stats); });
   }
@@ -1467,7 +1470,7 @@ bool ActTrainer::maybeRobot(int sector, float range_m, const Pixels& pixels) {
 template <class Pixels>
 void ActTrainer::removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats) {
   // Pixels one off-field sample stands for: the samples' stride over this cycle's density.
-  const float weight = static_cast<float>(removal_samples_stride_) / static_cast<float>(density_);
+  const float weight = static_cast<float>(removal_samples_stride_) / static_cast<float>(samplingDensity(stats));
   // |mu_k - c| > xi * sigma_k, compared as squared distances in float.
   std::array<Eigen::Vector3f, kNumClasses> remove_mean;
   std::array<float, kNumClasses> remove_radius_sq;

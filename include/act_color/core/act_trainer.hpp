@@ -303,7 +303,7 @@ class ActTrainer {
   // table, clusters and evidence instead of moving the table once more. Moving it to and fro would
   // spread every class a cell further with each round (the table filled to 98% under flicker).
   // Returns true when it restored one (the state left is kept in its place). A restored light's
-  // cycle samples the frame kRestoredDensity times as densely (density_).
+  // cycle samples the frame kRestoredDensity times as densely (samplingDensity).
   bool restoreLightState();
   void keepLightState();
   // robots_train_black's intensity below which a color is dark, in this cycle's light.
@@ -428,9 +428,6 @@ class ActTrainer {
   std::unordered_map<int, int> sampling_strides_;
   int add_weight_ = 1;              // pixels one in-field sample stands for in this cycle
   uint64_t last_light_change_ = 0;  // revision_ + 1 of the last change of light; 0: none
-  // This cycle's sampling density of 2.3's additions, learned_boundary and 2.4's removal: 1, or
-  // kRestoredDensity in a restored light's cycle (each sample standing for as many fewer pixels).
-  int density_ = 1;
   // pose_check: true when this cycle is not to train (stats: contradiction, pose_contradicted).
   bool poseContradicted(CycleStats& stats);
   // The share of this cycle's cluster samples of green, white and the goals whose color the table
