@@ -266,6 +266,12 @@ class ActTrainer {
   // The class a sample expected as k trains (robots_train_black re-routes green and goal colors
   // of robots to black); `dark_limit` is darkLimit() of the clusters the pass samples against.
   uint8_t trainedClass(uint8_t k, const uint8_t c[3], double dark_limit) const;
+  // robots_train_black: a robot is a body, not a pixel. Adds the color c of a sample at (u, v) that
+  // trained black where the pose expects the carpet or a goal, and those of the pixels around it
+  // that do too, together standing for the sample's pixels (add_weight_); the sample alone near
+  // the field's edge.
+  uint32_t addRobotBody(const ImageView& image, const PoseTransform& transform, int u, int v, const uint8_t c[3],
+                        double dark_limit);
   // ActParams::learned_boundary: counts this cycle's pixels near the carpet-line boundary, learns
   // the split from the counts and removes the white cells that lie wholly on the carpet's side.
   void learnBoundary(const ImageView& image, const PoseTransform& transform, CycleStats& stats);
