@@ -28,6 +28,17 @@ ClassificationMetrics evaluate(const ActTrainer& trainer, const act_color::sim::
   return m;
 }
 
+// The tests' per-seed runs: a trainer with sample seed `seed`, bootstrapped on `image` at `pose`
+// (20 cycles), then `cycles` cycles more on it.
+ActTrainer trainedOn(const Calibration& cal, const ImageView& image, const Pose2D& pose, uint32_t seed, int cycles) {
+  ActParams p;
+  p.seed = seed;
+  ActTrainer trainer(cal, p);
+  trainer.bootstrap(image, pose, 20);
+  for (int i = 0; i < cycles; ++i) trainer.cycle(image, pose);
+  return trainer;
+}
+
 // The pixels of `mask` on every n-th row (from row 0), over `reference` pixels.
 double rowsShare(const cv::Mat& mask, int every_nth_row, int reference) {
   int count = 0;
@@ -950,10 +961,7 @@ TEST_F(ActTrainerTest, ARobotInFrontOfAGoalAtStartUpDoesNotBecomeTheGoal) {
   ASSERT_GT(goal_pixels, 2000);
   ASSERT_GT(covered, goal_pixels / 2);
   for (uint32_t seed = 1; seed <= 4; ++seed) {
-    ActParams p;
-    p.seed = seed;
-    ActTrainer trainer(cal, p);
-    trainer.bootstrap(view(frame.rgb), facing_goal, 20);
+    const ActTrainer trainer = trainedOn(cal, view(frame.rgb), facing_goal, seed, 0);
     const Eigen::Vector3d black = trainer.clusters()[kBlack].mean(), blue = trainer.clusters()[kBlue].mean();
     EXPECT_GT((blue - black).norm(), 60.0) << "seed " << seed << ": blue " << blue.transpose();
     EXPECT_EQ(trainer.lut().classOf(chassis[0], chassis[1], chassis[2]), kBlack) << "seed " << seed;
@@ -998,11 +1006,7 @@ TEST_F(ActTrainerTest, ADarkNoisyGoalKeepsItsOwnShadesFromBlack) {
   ASSERT_GT(goal_pixels, 2000);
   ASSERT_GT(greyish, goal_pixels / 8);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
-    ActParams p;
-    p.seed = seed;
-    ActTrainer trainer(cal, p);
-    trainer.bootstrap(view(frame.rgb), facing_goal, 20);
-    for (int i = 0; i < 20; ++i) trainer.cycle(view(frame.rgb), facing_goal);
+    const ActTrainer trainer = trainedOn(cal, view(frame.rgb), facing_goal, seed, 20);
     const ClassificationMetrics m = evaluate(trainer, frame, cal);
     EXPECT_GT(m.recall(kBlue), 0.93) << "seed " << seed;
     EXPECT_GT(m.precision(kBlue), 0.95) << "seed " << seed;
@@ -1128,11 +1132,7 @@ TEST_F(ActTrainerTest, RobotsCoveringMuchOfTheCarpetStillTrainBlack) {
   ASSERT_GT(covered, green_pixels / 6);
   ASSERT_LT(covered, green_pixels / 4);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
-    ActParams p;
-    p.seed = seed;
-    ActTrainer trainer(cal, p);
-    trainer.bootstrap(view(frame.rgb), pose, 20);
-    for (int i = 0; i < 20; ++i) trainer.cycle(view(frame.rgb), pose);
+    const ActTrainer trainer = trainedOn(cal, view(frame.rgb), pose, seed, 20);
     EXPECT_EQ(trainer.lut().classOf(robot[0], robot[1], robot[2]), kBlack) << "seed " << seed;
     EXPECT_EQ(trainer.lut().classOf(carpet[0], carpet[1], carpet[2]), kGreen) << "seed " << seed;
     const ClassificationMetrics m = evaluate(trainer, frame, cal);
@@ -1179,11 +1179,7 @@ TEST_F(ActTrainerTest, ARobotsManyShadesAreLearnedFromItsBody) {
   }
   ASSERT_GT(robot_pixels, 3000);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
-    ActParams p;
-    p.seed = seed;
-    ActTrainer trainer(cal, p);
-    trainer.bootstrap(view(frame.rgb), pose, 20);
-    for (int i = 0; i < 2; ++i) trainer.cycle(view(frame.rgb), pose);
+    const ActTrainer trainer = trainedOn(cal, view(frame.rgb), pose, seed, 2);
     const ClassificationMetrics m = evaluate(trainer, frame, cal);
     EXPECT_GT(m.recall(kBlack), 0.77) << "seed " << seed;
     EXPECT_GT(m.precision(kBlack), 0.85) << "seed " << seed;
@@ -1205,10 +1201,7 @@ TEST_F(ActTrainerTest, AGoalMostlyHiddenByGreyRobotsKeepsItsColor) {
   ASSERT_GT(goal_pixels, 500);
   ASSERT_GT(covered, goal_pixels * 7 / 10);
   for (uint32_t seed = 1; seed <= 3; ++seed) {
-    ActParams p;
-    p.seed = seed;
-    ActTrainer trainer(cal, p);
-    trainer.bootstrap(view(frame.rgb), facing_goal, 20);
+    const ActTrainer trainer = trainedOn(cal, view(frame.rgb), facing_goal, seed, 0);
     EXPECT_NE(trainer.lut().classOf(robot[0], robot[1], robot[2]), kYellow) << "seed " << seed;
     EXPECT_EQ(trainer.lut().classOf(goal[0], goal[1], goal[2]), kYellow) << "seed " << seed;
     const Eigen::Vector3d goal_color(goal[0], goal[1], goal[2]);
@@ -1246,11 +1239,7 @@ TEST_F(ActTrainerTest, TheCarpetInAShadowStaysCarpetBesideDarkRobots) {
     const cv::Mat image = format == PixelFormat::kUyvy ? rgbToUyvy(frame.rgb) : frame.rgb;
     for (uint32_t seed = 1; seed <= 3; ++seed) {
       SCOPED_TRACE(std::string(encodingName(format)) + " seed " + std::to_string(seed));
-      ActParams p;
-      p.seed = seed;
-      ActTrainer trainer(cal, p);
-      trainer.bootstrap(ImageView::fromMat(image, format), pose, 20);
-      for (int i = 0; i < 20; ++i) trainer.cycle(ImageView::fromMat(image, format), pose);
+      const ActTrainer trainer = trainedOn(cal, ImageView::fromMat(image, format), pose, seed, 20);
       cv::Mat labels;
       Segmenter(cal.camera).classify(trainer.lut(), ImageView::fromMat(image, format), labels);
       ClassificationMetrics m;
