@@ -28,6 +28,15 @@ ClassificationMetrics evaluate(const ActTrainer& trainer, const act_color::sim::
   return m;
 }
 
+// Paints c as base +- spread per channel, uniformly, from the linear congruential sequence `state`
+// (sensor noise that the tests can repeat).
+void paintNoisy(cv::Vec3b& c, const int base[3], int spread, uint32_t& state) {
+  for (int ch = 0; ch < 3; ++ch) {
+    state = state * 1664525u + 1013904223u;
+    c[ch] = static_cast<uint8_t>(base[ch] + static_cast<int>((state >> 24) % (2 * spread + 1)) - spread);
+  }
+}
+
 // The tests' per-seed runs: a trainer with sample seed `seed`, bootstrapped on `image` at `pose`
 // (20 cycles), then `cycles` cycles more on it.
 ActTrainer trainedOn(const Calibration& cal, const ImageView& image, const Pose2D& pose, uint32_t seed, int cycles) {
@@ -981,12 +990,7 @@ TEST_F(ActTrainerTest, ADarkNoisyGoalKeepsItsOwnShadesFromBlack) {
   cv::Vec3b chassis(0, 0, 0);
   int goal_pixels = 0, greyish = 0;
   uint32_t hash = 1;
-  auto paint = [&](cv::Vec3b& c, const int base[3], int spread) {
-    for (int ch = 0; ch < 3; ++ch) {
-      hash = hash * 1664525u + 1013904223u;
-      c[ch] = static_cast<uint8_t>(base[ch] + static_cast<int>((hash >> 24) % (2 * spread + 1)) - spread);
-    }
-  };
+  auto paint = [&](cv::Vec3b& c, const int base[3], int spread) { paintNoisy(c, base, spread, hash); };
   for (int v = 0; v < 580; ++v) {
     for (int u = 0; u < 580; ++u) {
       const uint8_t k = model.geometricClass(v * 580 + u, t);
@@ -1165,12 +1169,8 @@ TEST_F(ActTrainerTest, ARobotsManyShadesAreLearnedFromItsBody) {
       for (int dv = -12; dv <= 12; ++dv) {
         for (int du = -12; du <= 12; ++du) {
           if (du * du + dv * dv > 144) continue;
-          cv::Vec3b& c = frame.rgb.at<cv::Vec3b>(v + dv, u + du);
           const int base[3] = {48, 48, 54};
-          for (int ch = 0; ch < 3; ++ch) {
-            hash = hash * 1664525u + 1013904223u;
-            c[ch] = static_cast<uint8_t>(base[ch] + static_cast<int>((hash >> 24) % 57) - 28);
-          }
+          paintNoisy(frame.rgb.at<cv::Vec3b>(v + dv, u + du), base, 28, hash);
           frame.labels.at<uint8_t>(v + dv, u + du) = kBlack;
           ++robot_pixels;
         }
