@@ -23,6 +23,11 @@ Segmenter::Segmenter(const CameraCalibration& camera) : width_(camera.width), he
     const int u1 = std::min(width_, static_cast<int>(std::floor(camera.center_u + half)) + 1);
     spans_[v] = {u0, std::max(u0, u1)};
   }
+  if (camera.self_mask.size() == static_cast<size_t>(width_) * height_) {
+    for (size_t i = 0; i < camera.self_mask.size(); ++i) {
+      if (camera.self_mask[i] != 0) self_pixels_.push_back(static_cast<uint32_t>(i));
+    }
+  }
 }
 
 namespace {
@@ -133,6 +138,8 @@ void Segmenter::classify(const LutView& lut, const ImageView& image, cv::Mat& la
         break;
     }
   }
+  uint8_t* out = labels.ptr<uint8_t>();  // continuous: made by create()
+  for (const uint32_t i : self_pixels_) out[i] = kBlack;
 }
 
 void colorizeLabels(const cv::Mat& labels, cv::Mat& rgb) {

@@ -130,13 +130,18 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
   result.seed = scene.seed;
   result.summary = scene.summary;
   const Renderer renderer(scene.calibration, scene.renderer);
-  const core::Segmenter segmenter(scene.calibration.camera);
+  core::Calibration calibration = scene.calibration;
+  if (options.self_mask) {
+    calibration.camera.self_mask = renderer.strutMask();
+    if (!calibration.camera.self_mask.empty()) calibration.camera.self_mask_file = "struts.png";
+  }
+  const core::Segmenter segmenter(calibration.camera);
   std::vector<core::ActTrainer> trainers;
   std::vector<core::RunEvaluation> evaluations;
   std::vector<cv::Mat> labels(modes.size());
   for (const EvalMode& m : modes) {
     result.mode_names.push_back(m.name);
-    trainers.emplace_back(scene.calibration, m.params);
+    trainers.emplace_back(calibration, m.params);
     evaluations.emplace_back(options.adapt_frames);
   }
   core::TableCeiling ceiling;

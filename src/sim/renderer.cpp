@@ -355,6 +355,15 @@ Renderer::Renderer(const core::Calibration& calibration, const RendererOptions& 
 
 const core::ExpectedClassModel& Renderer::model() const { return impl_->model; }
 
+std::vector<uint8_t> Renderer::strutMask() const {
+  const Impl& im = *impl_;
+  if (im.strut_of_pixel.empty()) return {};
+  const core::CameraCalibration& camera = im.calibration.camera;
+  std::vector<uint8_t> mask(static_cast<size_t>(camera.width) * camera.height, 0);
+  for (size_t n = 0; n < im.imaged.size(); ++n) mask[im.imaged[n]] = im.strut_of_pixel[n] != 0;
+  return mask;
+}
+
 namespace {
 
 const Patch* findPatch(const std::vector<Patch>& patches, double s, double t) {

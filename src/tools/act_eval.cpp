@@ -3,7 +3,7 @@
 // paper's algorithm side by side, the fixed-table ceiling of every scene segment, the gaps to it,
 // the cycles to settle after each event, and where the defaults fall below the paper.
 //   act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full] [--ablate]
-//            [--local-light] [--per-scene] [--png DIR] [--false-pixels]
+//            [--local-light] [--per-scene] [--png DIR] [--false-pixels] [--self-mask]
 // Tune on the tuning split (seeds 0-99); the report split (1000-1099) is for reporting only.
 #include <chrono>
 #include <cstdio>
@@ -24,7 +24,7 @@ namespace sim = act_color::sim;
 const char* const kUsage =
     "usage: act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full]\n"
     "                [--ablate] [--local-light] [--set NAME=VALUE] [--mode NAME:N=V,...] [--per-scene]\n"
-    "                [--png DIR] [--false-pixels]\n"
+    "                [--png DIR] [--false-pixels] [--self-mask]\n"
     "  --split S     report: seeds 1000-1099 (default); tuning: seeds 0-99\n"
     "  --seeds A-B   any range of seeds instead (inclusive)\n"
     "  --count N     only the first N seeds of the range (a quick subset)\n"
@@ -38,7 +38,9 @@ const char* const kUsage =
     "  --png DIR     input | labels of each mode | truth, for the last frame of every segment\n"
     "                (scene_SSSSS_frame_FFF.png; DIR is made if missing)\n"
     "  --false-pixels  also where each class's false pixels lie: in cells the ceiling gives the class\n"
-    "                too, in the hall's cells, in other classes' cells; clipped (slower)\n";
+    "                too, in the hall's cells, in other classes' cells; clipped (slower)\n"
+    "  --self-mask   each scene's calibration carries its mirror struts as the self mask (as after\n"
+    "                act_replay --learn-self-mask): they train nothing and are labelled black\n";
 
 int usage(const std::string& message) {
   std::cerr << "act_eval: " << message << "\n" << kUsage;
@@ -103,6 +105,8 @@ int main(int argc, char** argv) {
         options.png_dir = value();
       } else if (arg == "--false-pixels") {
         options.false_pixels = true;
+      } else if (arg == "--self-mask") {
+        options.self_mask = true;
       } else {
         return usage("unknown option " + arg);
       }

@@ -86,6 +86,30 @@ TEST(Segmenter, OnlyPixelsInsideTheMirrorAreClassified) {
                std::invalid_argument);
 }
 
+TEST(Segmenter, TheOwnRobotsPixelsOfTheSelfMaskAreBlack) {
+  auto cal = act_color::test::defaultCalibration();
+  // A strut from the chassis to the rim along +u, 3 px wide, in the camera's self mask.
+  cal.camera.self_mask.assign(580 * 580, 0);
+  for (int u = 340; u < 570; ++u) {
+    for (int v = 289; v <= 291; ++v) cal.camera.self_mask[static_cast<size_t>(v) * 580 + u] = 1;
+  }
+  ColorLut lut(6);
+  lut.set(lut.index(40, 140, 50), kGreen);
+  cv::Mat img(580, 580, CV_8UC3, cv::Scalar(40, 140, 50));
+  img(cv::Rect(340, 289, 230, 3)).setTo(cv::Scalar(170, 170, 180));  // a bright metal the table does not know
+  cv::Mat labels;
+  Segmenter(cal.camera).classify(lut, ImageView::fromMat(img, PixelFormat::kRgb8), labels);
+  EXPECT_EQ(cv::countNonZero(labels == kBlack), 230 * 3);
+  EXPECT_EQ(labels.at<uint8_t>(290, 400), kBlack);
+  EXPECT_EQ(labels.at<uint8_t>(288, 400), kGreen);  // beside it: the table's class
+  EXPECT_EQ(labels.at<uint8_t>(292, 400), kGreen);
+  // Without the mask the strut's color is no class.
+  cal.camera.self_mask.clear();
+  Segmenter(cal.camera).classify(lut, ImageView::fromMat(img, PixelFormat::kRgb8), labels);
+  EXPECT_EQ(labels.at<uint8_t>(290, 400), kUnknown);
+  EXPECT_EQ(cv::countNonZero(labels == kBlack), 0);
+}
+
 TEST(Segmenter, ColorizeUsesThePalette) {
   cv::Mat labels = (cv::Mat_<uint8_t>(1, 3) << kGreen, kBlue, kNotImaged);
   cv::Mat rgb;

@@ -24,7 +24,9 @@ class Segmenter {
  public:
   // Without a camera: every pixel is classified.
   Segmenter() = default;
-  // With a camera: only pixels inside the mirror are classified, the rest are kUnknown.
+  // With a camera: only pixels inside the mirror are classified, the rest are kUnknown. The pixels
+  // of the camera's self mask (the own robot's struts, a cable) are kBlack whatever their color, as
+  // the own chassis is: the contract's black is the robots, the own one included.
   explicit Segmenter(const CameraCalibration& camera);
 
   // labels: CV_8UC1 of the image's size, reallocated only when its size differs. Throws
@@ -39,6 +41,7 @@ class Segmenter {
   int height_ = 0;
   // Per row, the half-open column span inside the mirror; empty when no camera was given.
   std::vector<std::pair<int, int>> spans_;
+  std::vector<uint32_t> self_pixels_;  // the camera's self mask, as pixel indices
 };
 
 // Class ids to the rgb8 palette of classPalette(); 255 (not imaged) becomes dark grey.

@@ -29,6 +29,9 @@ struct EvalOptions {
   int bootstrap_cycles = 100;  // start-up training on the first frame, as act_replay
   std::string png_dir;         // when set: input | modes | truth of each segment's last frame
   bool false_pixels = false;   // SceneResult::false_pixels (a pass over every pixel per mode)
+  // Each scene's calibration carries its mirror struts as the self mask (Renderer::strutMask), as a
+  // team's does after `act_replay --learn-self-mask`; every mode trains and classifies with it.
+  bool self_mask = false;
 };
 
 // Issue 13's figures of the ball in one scene and mode. In scenes with a ball: pixels pooled over

@@ -171,6 +171,10 @@ class Renderer {
 
   const core::ExpectedClassModel& model() const;
 
+  // The pixels the own robot's mirror struts cover (row-major, 1 = strut): the self mask a team
+  // learns with `act_replay --learn-self-mask`; empty without struts.
+  std::vector<uint8_t> strutMask() const;
+
  private:
   struct Impl;
   std::shared_ptr<const Impl> impl_;
