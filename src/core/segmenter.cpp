@@ -23,9 +23,13 @@ Segmenter::Segmenter(const CameraCalibration& camera) : width_(camera.width), he
     const int u1 = std::min(width_, static_cast<int>(std::floor(camera.center_u + half)) + 1);
     spans_[v] = {u0, std::max(u0, u1)};
   }
+  // The own robot's pixels inside the mirror (as OmniCameraModel's PixelRegion::kSelf).
   if (camera.self_mask.size() == static_cast<size_t>(width_) * height_) {
-    for (size_t i = 0; i < camera.self_mask.size(); ++i) {
-      if (camera.self_mask[i] != 0) self_pixels_.push_back(static_cast<uint32_t>(i));
+    for (int v = 0; v < height_; ++v) {
+      for (int u = spans_[v].first; u < spans_[v].second; ++u) {
+        const size_t i = static_cast<size_t>(v) * width_ + u;
+        if (camera.self_mask[i] != 0) self_pixels_.push_back(static_cast<uint32_t>(i));
+      }
     }
   }
 }

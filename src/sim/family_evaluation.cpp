@@ -131,10 +131,7 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
   result.summary = scene.summary;
   const Renderer renderer(scene.calibration, scene.renderer);
   core::Calibration calibration = scene.calibration;
-  if (options.self_mask) {
-    calibration.camera.self_mask = renderer.strutMask();
-    if (!calibration.camera.self_mask.empty()) calibration.camera.self_mask_file = "struts.png";
-  }
+  if (options.self_mask) calibration.camera.self_mask = renderer.strutMask();
   const core::Segmenter segmenter(calibration.camera);
   std::vector<core::ActTrainer> trainers;
   std::vector<core::RunEvaluation> evaluations;
