@@ -36,10 +36,20 @@ OmniCameraModel::OmniCameraModel(const CameraCalibration& camera)
     for (int u = 0; u < camera_.width; ++u) rays_[static_cast<size_t>(v) * camera_.width + u] = computeRay(u, v);
   }
   // Pixels of the self mask show the own robot (struts, cables): their view rays are kept, their
-  // region says they show no class.
+  // region says they show no class. So do the pixels right next to them (8-neighbours): a part's
+  // blurred edge is neither the part nor what lies behind it.
   if (camera_.self_mask.size() == rays_.size()) {
-    for (size_t i = 0; i < rays_.size(); ++i) {
-      if (camera_.self_mask[i] && rays_[i].region != PixelRegion::kNotImaged) rays_[i].region = PixelRegion::kSelf;
+    const int w = camera_.width, h = camera_.height;
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        if (!camera_.self_mask[static_cast<size_t>(v) * w + u]) continue;
+        for (int nv = std::max(0, v - 1); nv <= std::min(h - 1, v + 1); ++nv) {
+          for (int nu = std::max(0, u - 1); nu <= std::min(w - 1, u + 1); ++nu) {
+            PixelRay& ray = rays_[static_cast<size_t>(nv) * w + nu];
+            if (ray.region != PixelRegion::kNotImaged) ray.region = PixelRegion::kSelf;
+          }
+        }
+      }
     }
   }
 }

@@ -23,7 +23,8 @@ Segmenter::Segmenter(const CameraCalibration& camera) : width_(camera.width), he
     const int u1 = std::min(width_, static_cast<int>(std::floor(camera.center_u + half)) + 1);
     spans_[v] = {u0, std::max(u0, u1)};
   }
-  // The own robot's pixels inside the mirror (as OmniCameraModel's PixelRegion::kSelf).
+  // The own robot's pixels inside the mirror (the mask itself; OmniCameraModel's PixelRegion::kSelf,
+  // which trains nothing, also takes their blurred edges).
   if (camera.self_mask.size() == static_cast<size_t>(width_) * height_) {
     for (int v = 0; v < height_; ++v) {
       for (int u = spans_[v].first; u < spans_[v].second; ++u) {

@@ -37,6 +37,8 @@ SelfMaskLearner::SelfMaskLearner(const Calibration& calibration)
   const size_t pixels = model_.pixels();
   looked_.assign(pixels, 0);
   mismatched_.assign(pixels, 0);
+  color_sum_.assign(3 * pixels, 0.0f);
+  color_sum_sq_.assign(pixels, 0.0f);
 }
 
 void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const ColorLut& lut) {
@@ -53,6 +55,10 @@ void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const Colo
   last_pose_ = pose;
   ++frames_;
   const PoseTransform transform(pose);
+  // The carpet's brightness in this frame: colors are summed relative to it, so that a change of
+  // light (a gain: auto exposure, lamps) during the drive does not count as a change of color.
+  double carpet_sum = 0;
+  size_t carpet_pixels = 0;
   for (int v = 0; v < camera.height(); ++v) {
     for (int u = 0; u < camera.width(); ++u) {
       const size_t i = static_cast<size_t>(v) * camera.width() + u;
@@ -63,6 +69,24 @@ void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const Colo
       const uint8_t k = lut.classOf(c[0], c[1], c[2]);
       ++looked_[i];
       if (k != kGreen && k != kWhite) ++mismatched_[i];
+      if (expected == kGreen && k == kGreen) {
+        carpet_sum += c[0] + c[1] + c[2];
+        ++carpet_pixels;
+      }
+    }
+  }
+  const float scale =
+      carpet_sum > 0 ? static_cast<float>(3.0 * kCarpetLevel * static_cast<double>(carpet_pixels) / carpet_sum) : 1.0f;
+  for (int v = 0; v < camera.height(); ++v) {
+    for (int u = 0; u < camera.width(); ++u) {
+      const size_t i = static_cast<size_t>(v) * camera.width() + u;
+      uint8_t c[3];
+      image.color(u, v, c);
+      for (int ch = 0; ch < 3; ++ch) {
+        const float x = scale * c[ch];
+        color_sum_[3 * i + ch] += x;
+        color_sum_sq_[i] += x * x;
+      }
     }
   }
 }
@@ -130,8 +154,44 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
       if (!attached[static_cast<size_t>(labels.at<int>(v, u))]) mask.at<uint8_t>(v, u) = 0;
     }
   }
-  // One pixel more all round: the blurred edges of a strut are neither carpet nor strut.
-  cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  // Where a part runs on beyond the field, along the radius through the pixels nothing was
+  // expected at (or that showed neither carpet nor line) as long as they keep their color.
+  if (frames_ >= kMinPosesForConstancy) {
+    const double n = frames_;
+    auto constant = [&](size_t i) {
+      double mean_sq = 0;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double m = color_sum_[3 * i + ch] / n;
+        mean_sq += m * m;
+      }
+      return (color_sum_sq_[i] / n - mean_sq) / 3.0 <= kConstantSd * kConstantSd;
+    };
+    auto open = [&](int u, int v) {
+      if (u < 0 || v < 0 || u >= width || v >= height) return false;
+      const size_t i = static_cast<size_t>(v) * width + u;
+      const PixelRegion region = camera.ray(i).region;
+      if (region == PixelRegion::kNotImaged || region == PixelRegion::kChassis) return false;
+      return (looked_[i] < min_looked || candidates.at<uint8_t>(v, u)) && constant(i);
+    };
+    const cv::Mat seeds = mask.clone();
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        if (!seeds.at<uint8_t>(v, u)) continue;
+        const double du = u - cal.center_u, dv = v - cal.center_v;
+        const double r = std::hypot(du, dv);
+        if (r <= 0) continue;
+        const double ex = du / r, ey = dv / r;
+        for (const double dir : {1.0, -1.0}) {
+          for (double s = 1;; ++s) {
+            const int gu = static_cast<int>(std::lround(u + dir * s * ex)),
+                      gv = static_cast<int>(std::lround(v + dir * s * ey));
+            if (!open(gu, gv)) break;
+            mask.at<uint8_t>(gv, gu) = 255;
+          }
+        }
+      }
+    }
+  }
   out.assign(static_cast<size_t>(width) * height, 0);
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {

@@ -7,9 +7,11 @@
 #include <functional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 #include <stdexcept>
 
 #include "act_color/core/segmenter.hpp"
+#include "act_color/core/self_mask_learner.hpp"
 #include "act_color/core/table_ceiling.hpp"
 #include "act_color/sim/renderer.hpp"
 
@@ -125,13 +127,56 @@ std::vector<EvalMode> evalModes(bool ablations) {
   return modes;
 }
 
+std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses) {
+  if (scene.scenario.frames.empty()) return {};
+  core::Calibration calibration = scene.calibration;
+  calibration.camera.self_mask.clear();
+  calibration.camera.self_mask_file.clear();
+  const Renderer renderer(calibration, scene.renderer);
+  core::ActTrainer trainer(calibration, core::ActParams());
+  core::SelfMaskLearner learner(calibration);
+  Scene drive = scene.scenario.frames.front().scene;
+  std::mt19937 rng(scene.seed * 7919u + 17u);
+  const double half_x = 0.45 * calibration.field.length_m, half_y = 0.45 * calibration.field.width_m;
+  std::uniform_real_distribution<double> x(-half_x, half_x), y(-half_y, half_y), theta(-M_PI, M_PI);
+  // Where the own robot (some 0.25 m in radius) can stand: off the other robots and the ball.
+  auto free = [&](double px, double py) {
+    for (const RobotObstacle& r : drive.robots) {
+      if (std::hypot(px - r.x_m, py - r.y_m) < r.radius_m + 0.3) return false;
+    }
+    return !drive.ball || std::hypot(px - drive.ball->x_m, py - drive.ball->y_m) >= 0.4;
+  };
+  for (int k = 0, tries = 0; k < poses && tries < 50 * poses; ++tries) {
+    core::Pose2D pose{x(rng), y(rng), theta(rng)};
+    if (!free(pose.x_m, pose.y_m)) continue;
+    drive.robot_pose = pose;
+    drive.noise_seed = 5000u + static_cast<uint32_t>(k);
+    const LabeledFrame frame = renderer.render(drive);
+    const core::ImageView view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
+    if (k == 0) trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles);
+    for (int c = 0; c < kDriveCyclesPerPose; ++c) trainer.cycle(view, pose);
+    learner.add(view, pose, trainer.lut());
+    ++k;
+  }
+  return learner.mask();
+}
+
 SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>& modes, const EvalOptions& options) {
   SceneResult result;
   result.seed = scene.seed;
   result.summary = scene.summary;
   const Renderer renderer(scene.calibration, scene.renderer);
   core::Calibration calibration = scene.calibration;
-  if (options.self_mask) calibration.camera.self_mask = renderer.strutMask();
+  const std::vector<uint8_t> struts = renderer.strutMask();
+  if (options.self_mask == SelfMaskSource::kStruts) calibration.camera.self_mask = struts;
+  if (options.self_mask == SelfMaskSource::kLearnedOnDrive)
+    calibration.camera.self_mask = learnSelfMaskOnDrive(scene, kDrivePoses);
+  for (size_t i = 0; i < calibration.camera.self_mask.size(); ++i) {
+    const bool strut = i < struts.size() && struts[i];
+    result.self_mask_pixels += calibration.camera.self_mask[i];
+    result.self_mask_on_struts += calibration.camera.self_mask[i] && strut;
+  }
+  result.strut_pixels = static_cast<size_t>(std::count(struts.begin(), struts.end(), uint8_t{1}));
   const core::Segmenter segmenter(calibration.camera);
   std::vector<core::ActTrainer> trainers;
   std::vector<core::RunEvaluation> evaluations;
@@ -438,6 +483,11 @@ std::string formatScene(const SceneResult& s) {
   out += line;
   out += s.summary;
   out += "\n";
+  if (s.self_mask_pixels > 0) {
+    std::snprintf(line, sizeof(line), "  self mask %zu px, %zu of them on the %zu px of the struts\n",
+                  s.self_mask_pixels, s.self_mask_on_struts, s.strut_pixels);
+    out += line;
+  }
   for (size_t seg = 0; seg < s.ceiling.size(); ++seg) {
     std::snprintf(line, sizeof(line), "  segment '%s' F1", s.segments[0][seg].event.c_str());
     out += line;

@@ -4,6 +4,7 @@
 // the cycles to settle after each event, and where the defaults fall below the paper.
 //   act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full] [--ablate]
 //            [--local-light] [--per-scene] [--png DIR] [--false-pixels] [--self-mask]
+//            [--learn-self-mask]
 // Tune on the tuning split (seeds 0-99); the report split (1000-1099) is for reporting only.
 #include <chrono>
 #include <cstdio>
@@ -24,7 +25,7 @@ namespace sim = act_color::sim;
 const char* const kUsage =
     "usage: act_eval [--split report|tuning] [--seeds A-B] [--count N] [--length small|full]\n"
     "                [--ablate] [--local-light] [--set NAME=VALUE] [--mode NAME:N=V,...] [--per-scene]\n"
-    "                [--png DIR] [--false-pixels] [--self-mask]\n"
+    "                [--png DIR] [--false-pixels] [--self-mask | --learn-self-mask]\n"
     "  --split S     report: seeds 1000-1099 (default); tuning: seeds 0-99\n"
     "  --seeds A-B   any range of seeds instead (inclusive)\n"
     "  --count N     only the first N seeds of the range (a quick subset)\n"
@@ -40,7 +41,9 @@ const char* const kUsage =
     "  --false-pixels  also where each class's false pixels lie: in cells the ceiling gives the class\n"
     "                too, in the hall's cells, in other classes' cells; clipped (slower)\n"
     "  --self-mask   each scene's calibration carries its mirror struts as the self mask (as after\n"
-    "                act_replay --learn-self-mask): they train nothing and are labelled black\n";
+    "                act_replay --learn-self-mask, at best): they train nothing and are labelled black\n"
+    "  --learn-self-mask  the self mask learned first, as a team does it: a drive over the field\n"
+    "                (24 random poses, the scene's first light) with core::SelfMaskLearner\n";
 
 int usage(const std::string& message) {
   std::cerr << "act_eval: " << message << "\n" << kUsage;
@@ -106,7 +109,9 @@ int main(int argc, char** argv) {
       } else if (arg == "--false-pixels") {
         options.false_pixels = true;
       } else if (arg == "--self-mask") {
-        options.self_mask = true;
+        options.self_mask = sim::SelfMaskSource::kStruts;
+      } else if (arg == "--learn-self-mask") {
+        options.self_mask = sim::SelfMaskSource::kLearnedOnDrive;
       } else {
         return usage("unknown option " + arg);
       }

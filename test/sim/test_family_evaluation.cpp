@@ -95,7 +95,7 @@ TEST(FamilyEvaluation, TheStrutsGivenAsTheSelfMaskAreBlack) {
   const sim::FamilyScene scene = sim::makeFamilyScene(sim::kTuningSeedsBegin + 27);
   const std::vector<sim::EvalMode> defaults = {sim::evalModes(false)[0]};
   sim::EvalOptions with_mask;
-  with_mask.self_mask = true;
+  with_mask.self_mask = sim::SelfMaskSource::kStruts;
   const sim::SceneResult plain = sim::evaluateScene(scene, defaults, sim::EvalOptions{});
   const sim::SceneResult masked = sim::evaluateScene(scene, defaults, with_mask);
   ASSERT_EQ(plain.segments[0].size(), masked.segments[0].size());

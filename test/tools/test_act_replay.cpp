@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <iterator>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -21,11 +22,14 @@
 #include "act_color/core/calibration.hpp"
 #include "act_color/ros/bag_replay.hpp"
 #include "act_color/ros/conversions.hpp"
+#include "act_color/sim/renderer.hpp"
+#include "act_color/sim/scene_family.hpp"
 #include "tool_test_util.hpp"
 
 using act_color::ros_layer::ReplayError;
 using act_color::ros_layer::ReplayOptions;
 using act_color::ros_layer::runReplay;
+namespace sim = act_color::sim;
 
 namespace {
 
@@ -575,4 +579,56 @@ TEST(ActEval, OneSceneReportAndFamilyBag) {
   std::ifstream brief(tempDir() + "/family_3.txt");
   const std::string summary((std::istreambuf_iterator<char>(brief)), std::istreambuf_iterator<char>());
   EXPECT_NE(summary.find("green"), std::string::npos) << summary;
+}
+
+// A team's way to its self mask: act_replay --learn-self-mask on a bag of a drive, then the
+// calibration given the PNG. Family scene 40: three struts, driving, the light halved halfway.
+TEST(ActReplay, LearnsTheSelfMaskFromADriveAndItsStrutsAreBlack) {
+  const std::string dir = act_color_tool_test::tempDir("act_replay_self_mask");
+  ASSERT_EQ(std::system((std::string(ACT_TOOLS_DIR) + "/act_make_scenarios --family 40 --length small --output-dir " +
+                         dir + " > /dev/null")
+                            .c_str()),
+            0);
+  const std::string bag = " --bag " + dir + "/family_40.bag --output " + dir + "/out.bag --brief --no-progress";
+  const auto learned = act_color_tool_test::runTool(
+      "act_replay", bag + " --calibration " + dir + "/family_40.yaml --learn-self-mask " + dir + "/mask.png", dir);
+  ASSERT_EQ(learned.exit_code, 0) << learned.output;
+  EXPECT_NE(learned.output.find("self mask learned from 13 poses"), std::string::npos) << learned.output;
+  const cv::Mat mask = cv::imread(dir + "/mask.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(mask.cols, 640);
+  ASSERT_EQ(mask.rows, 480);
+  const sim::FamilyScene scene = sim::makeFamilyScene(40);
+  const std::vector<uint8_t> struts = sim::Renderer(scene.calibration, scene.renderer).strutMask();
+  ASSERT_EQ(struts.size(), mask.total());
+  size_t on = 0, off = 0, strut_pixels = 0;
+  for (size_t i = 0; i < struts.size(); ++i) {
+    strut_pixels += struts[i];
+    (struts[i] ? on : off) += mask.data[i] != 0;
+  }
+  // Over the field and, as they keep their color from pose to pose, over the hall.
+  EXPECT_GT(on, 0.9 * strut_pixels) << on << " of " << strut_pixels;
+  EXPECT_LT(off, 0.01 * strut_pixels);
+
+  std::string yaml = act_color_tool_test::readText(dir + "/family_40.yaml");
+  const size_t camera = yaml.find("camera:\n");
+  ASSERT_NE(camera, std::string::npos);
+  yaml.insert(camera + 8, "  self_mask: mask.png\n");
+  std::ofstream(dir + "/masked.yaml") << yaml;
+  // Black's adapted recall in the brief summary: "  black  all adapt  all adapt".
+  auto blackRecall = [&](const std::string& calibration) {
+    const auto run = act_color_tool_test::runTool("act_replay", bag + " --calibration " + dir + "/" + calibration, dir);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    std::istringstream lines(run.output);
+    for (std::string line; std::getline(lines, line);) {
+      std::istringstream words(line);
+      std::string name;
+      double all = 0, adapted = 0;
+      if (words >> name >> all >> adapted && name == "black") return adapted;
+    }
+    ADD_FAILURE() << "no black line in:\n" << run.output;
+    return 0.0;
+  };
+  const double without = blackRecall("family_40.yaml"), with = blackRecall("masked.yaml");
+  std::printf("black recall %.3f without the mask, %.3f with it\n", without, with);
+  EXPECT_GT(with, without + 0.3);
 }

@@ -15,7 +15,7 @@ enum class PixelRegion : uint8_t {
   kChassis = 1,       // the own robot
   kFloor = 2,         // ray below the horizon: meets the floor
   kAboveHorizon = 3,  // ray at or above the horizon
-  kSelf = 4,          // the own robot in front of the mirror (the calibration's self mask): no class
+  kSelf = 4,          // the own robot in front of the mirror (the self mask and its 8-neighbours): no class
 };
 
 // Precomputed view ray of one pixel in base_link, from the viewpoint (0, 0, height_m).

@@ -19,7 +19,10 @@ namespace core {
 // kMismatchFraction of the frames that looked at it, and its connected part of the image is one
 // the own robot makes: touching the chassis, or long along the radius and narrow across it (a
 // strut or cable). Robots and people on the field are compact and, once the robot has moved, are
-// seen at other pixels. The result is the calibration's self mask (CameraCalibration::self_mask).
+// seen at other pixels. Where a part runs on beyond the field (nothing is expected there), it is
+// followed along the radius as far as the pixels keep their color from pose to pose (from
+// kMinPosesForConstancy poses on): the own robot moves with the camera, the hall does not. The
+// result is the calibration's self mask (CameraCalibration::self_mask).
 class SelfMaskLearner {
  public:
   // The calibration's own self mask is ignored: every imaged pixel is looked at.
@@ -40,12 +43,20 @@ class SelfMaskLearner {
   static constexpr double kMismatchFraction = 0.8;
   static constexpr double kMinMoveM = 0.25;
   static constexpr double kMinTurnRad = 0.17;  // 10 degrees
+  static constexpr int kMinPosesForConstancy = 8;
+  // A pixel keeps its color when its standard deviation over the poses (RMS over the channels),
+  // its colors scaled so that the carpet's mean level is kCarpetLevel in every frame, is at most
+  // kConstantSd: sensor noise and light that differs a little from place to place.
+  static constexpr double kCarpetLevel = 100.0;
+  static constexpr double kConstantSd = 15.0;
 
  private:
   Calibration calibration_;
   ExpectedClassModel model_;
   std::vector<uint16_t> looked_;
   std::vector<uint16_t> mismatched_;
+  std::vector<float> color_sum_;     // [pixel * 3 + channel], over the poses counted
+  std::vector<float> color_sum_sq_;  // [pixel], squares summed over the channels
   int frames_ = 0;
   Pose2D last_pose_;
 };

@@ -24,14 +24,28 @@ struct EvalMode {
 // each extension off in turn (named "no_<parameter>").
 std::vector<EvalMode> evalModes(bool ablations);
 
+// Where a scene's self mask comes from: none; its mirror struts (Renderer::strutMask: every pixel a
+// strut covers, the best a team's calibration can hold); or learned as a team does it, by
+// learnSelfMaskOnDrive before the scene's frames.
+enum class SelfMaskSource { kNone, kStruts, kLearnedOnDrive };
+
+// What a team does with `act_replay --learn-self-mask` on a drive over its field: the scene's first
+// frame's hall, robots, ball and light seen from `poses` random poses on the field (told exactly),
+// a default ActTrainer without a mask trained along (bootstrapped at the first pose, then
+// kDriveCyclesPerPose cycles at each) and core::SelfMaskLearner fed the table after each pose's
+// cycles. Deterministic in the scene's seed.
+constexpr int kDrivePoses = 24;
+constexpr int kDriveCyclesPerPose = 5;
+std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses);
+
 struct EvalOptions {
   size_t adapt_frames = 12;    // frames of each segment before "after adaptation"
   int bootstrap_cycles = 100;  // start-up training on the first frame, as act_replay
   std::string png_dir;         // when set: input | modes | truth of each segment's last frame
   bool false_pixels = false;   // SceneResult::false_pixels (a pass over every pixel per mode)
-  // Each scene's calibration carries its mirror struts as the self mask (Renderer::strutMask), as a
-  // team's does after `act_replay --learn-self-mask`; every mode trains and classifies with it.
-  bool self_mask = false;
+  // The self mask each scene's calibration carries (CameraCalibration::self_mask); every mode
+  // trains and classifies with it.
+  SelfMaskSource self_mask = SelfMaskSource::kNone;
 };
 
 // Issue 13's figures of the ball in one scene and mode. In scenes with a ball: pixels pooled over
@@ -68,6 +82,8 @@ struct SceneResult {
   std::vector<BallFigures> ball;  // [mode]
   // With EvalOptions::false_pixels: [mode][segment], after adaptation, against the ceiling's table.
   std::vector<std::vector<std::array<core::FalsePixels, core::kNumClasses>>> false_pixels;
+  // The self mask against the struts (imaged pixels): its size, the struts' and both.
+  size_t self_mask_pixels = 0, strut_pixels = 0, self_mask_on_struts = 0;
 };
 
 SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>& modes, const EvalOptions& options);
