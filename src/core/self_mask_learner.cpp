@@ -37,8 +37,8 @@ SelfMaskLearner::SelfMaskLearner(const Calibration& calibration)
   const size_t pixels = model_.pixels();
   looked_.assign(pixels, 0);
   mismatched_.assign(pixels, 0);
-  color_sum_.assign(3 * pixels, 0.0f);
-  color_sum_sq_.assign(pixels, 0.0f);
+  color_sum_.assign(3 * pixels, 0.0);
+  color_sum_sq_.assign(pixels, 0.0);
 }
 
 void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const ColorLut& lut) {
@@ -75,15 +75,14 @@ void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const Colo
       }
     }
   }
-  const float scale =
-      carpet_sum > 0 ? static_cast<float>(3.0 * kCarpetLevel * static_cast<double>(carpet_pixels) / carpet_sum) : 1.0f;
+  const double scale = carpet_sum > 0 ? 3.0 * kCarpetLevel * static_cast<double>(carpet_pixels) / carpet_sum : 1.0;
   for (int v = 0; v < camera.height(); ++v) {
     for (int u = 0; u < camera.width(); ++u) {
       const size_t i = static_cast<size_t>(v) * camera.width() + u;
       uint8_t c[3];
       image.color(u, v, c);
       for (int ch = 0; ch < 3; ++ch) {
-        const float x = scale * c[ch];
+        const double x = scale * c[ch];
         color_sum_[3 * i + ch] += x;
         color_sum_sq_[i] += x * x;
       }

@@ -55,8 +55,10 @@ class SelfMaskLearner {
   ExpectedClassModel model_;
   std::vector<uint16_t> looked_;
   std::vector<uint16_t> mismatched_;
-  std::vector<float> color_sum_;     // [pixel * 3 + channel], over the poses counted
-  std::vector<float> color_sum_sq_;  // [pixel], squares summed over the channels
+  // Over the poses counted, in double (a match counts thousands of poses): colors [pixel * 3 +
+  // channel] and squares summed over the channels [pixel].
+  std::vector<double> color_sum_;
+  std::vector<double> color_sum_sq_;
   int frames_ = 0;
   Pose2D last_pose_;
 };
