@@ -12,6 +12,7 @@
 #include <string>
 
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/self_mask_learner.hpp"
 #include "act_color/ros/bag_replay.hpp"
 
 namespace {
@@ -182,6 +183,13 @@ int main(int argc, char** argv) {
           "act_replay: self mask learned from %d poses: %.2f%% of the imaged pixels; wrote %s (set camera.self_mask "
           "to it)\n",
           result.self_mask_poses, 100.0 * result.self_mask_fraction, options.self_mask_png.c_str());
+      if (result.self_mask_poses < act_color::core::SelfMaskLearner::kMinPosesForConstancy) {
+        std::printf(
+            "act_replay: fewer than %d distinct poses (%.2f m or %.0f deg apart): only the parts over the field were "
+            "learned; a longer drive also finds where they cross the hall\n",
+            act_color::core::SelfMaskLearner::kMinPosesForConstancy, act_color::core::SelfMaskLearner::kMinMoveM,
+            act_color::core::SelfMaskLearner::kMinTurnRad * 180.0 / M_PI);
+      }
     }
     if (result.with_truth > 0) {
       std::cout << (brief ? result.evaluation.brief() : result.evaluation.report());

@@ -594,6 +594,7 @@ TEST(ActReplay, LearnsTheSelfMaskFromADriveAndItsStrutsAreBlack) {
       "act_replay", bag + " --calibration " + dir + "/family_40.yaml --learn-self-mask " + dir + "/mask.png", dir);
   ASSERT_EQ(learned.exit_code, 0) << learned.output;
   EXPECT_NE(learned.output.find("self mask learned from 13 poses"), std::string::npos) << learned.output;
+  EXPECT_EQ(learned.output.find("fewer than"), std::string::npos) << learned.output;
   const cv::Mat mask = cv::imread(dir + "/mask.png", cv::IMREAD_GRAYSCALE);
   ASSERT_EQ(mask.cols, 640);
   ASSERT_EQ(mask.rows, 480);
@@ -631,4 +632,19 @@ TEST(ActReplay, LearnsTheSelfMaskFromADriveAndItsStrutsAreBlack) {
   const double without = blackRecall("family_40.yaml"), with = blackRecall("masked.yaml");
   std::printf("black recall %.3f without the mask, %.3f with it\n", without, with);
   EXPECT_GT(with, without + 0.3);
+
+  // Family scene 0 stands still, then drives: 6 distinct poses, too few to follow the struts over
+  // the hall, and the replay says so.
+  ASSERT_EQ(std::system((std::string(ACT_TOOLS_DIR) + "/act_make_scenarios --family 0 --length small --output-dir " +
+                         dir + " > /dev/null")
+                            .c_str()),
+            0);
+  const auto few = act_color_tool_test::runTool("act_replay",
+                                                " --bag " + dir + "/family_0.bag --output " + dir +
+                                                    "/out0.bag --brief --no-progress --calibration " + dir +
+                                                    "/family_0.yaml --learn-self-mask " + dir + "/mask0.png",
+                                                dir);
+  ASSERT_EQ(few.exit_code, 0) << few.output;
+  EXPECT_NE(few.output.find("self mask learned from 6 poses"), std::string::npos) << few.output;
+  EXPECT_NE(few.output.find("fewer than 8 distinct poses"), std::string::npos) << few.output;
 }
