@@ -1,6 +1,7 @@
 #include "act_color/core/self_mask_learner.hpp"
 
 #include <algorithm>
+#include <bitset>
 #include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
@@ -54,6 +55,8 @@ void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const Colo
   if (frames_ == std::numeric_limits<uint16_t>::max()) return;  // the counts are full
   last_pose_ = pose;
   ++frames_;
+  const double turn = std::remainder(pose.theta_rad, 2 * M_PI) + M_PI;  // [0, 2 pi]
+  heading_sectors_ |= 1u << (static_cast<unsigned>(turn / (2 * M_PI) * kHeadingSectors) % kHeadingSectors);
   const PoseTransform transform(pose);
   // The carpet's brightness in this frame: colors are summed relative to it, so that a change of
   // light (a gain: auto exposure, lamps) during the drive does not count as a change of color.
@@ -172,6 +175,50 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
       if (region == PixelRegion::kNotImaged || region == PixelRegion::kChassis) return false;
       return (looked_[i] < min_looked || candidates.at<uint8_t>(v, u)) && constant(i);
     };
+    // A part that lies over the hall only: a long run along the radius of pixels nothing was
+    // expected at that keep their color, narrow across it (a wall or ceiling of one color keeps
+    // its color too, but all round). Only once the robot has faced kMinHeadingSectors directions:
+    // driving straight on, a pole far to the side stays at its pixels too.
+    const bool turned = std::bitset<kHeadingSectors>(heading_sectors_).count() >= kMinHeadingSectors;
+    cv::Mat hall(height, width, CV_8UC1, cv::Scalar(0));
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        const size_t i = static_cast<size_t>(v) * width + u;
+        const PixelRegion region = camera.ray(i).region;
+        if (turned && region != PixelRegion::kNotImaged && region != PixelRegion::kChassis && looked_[i] < min_looked &&
+            constant(i))
+          hall.at<uint8_t>(v, u) = 1;
+      }
+    }
+    auto run = [&](const cv::Mat& set, int u, int v, double ex, double ey, double limit) {
+      auto in = [&](double x, double y) {
+        const int iu = static_cast<int>(std::lround(x)), iv = static_cast<int>(std::lround(y));
+        return iu >= 0 && iv >= 0 && iu < width && iv < height && set.at<uint8_t>(iv, iu) != 0;
+      };
+      double length = 1;
+      for (double s = 1; length <= limit && in(u + s * ex, v + s * ey); ++s) ++length;
+      for (double s = 1; length <= limit && in(u - s * ex, v - s * ey); ++s) ++length;
+      return length;
+    };
+    cv::Mat narrow(height, width, CV_8UC1, cv::Scalar(0));
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        if (!hall.at<uint8_t>(v, u)) continue;
+        const double du = u - cal.center_u, dv = v - cal.center_v;
+        const double r = std::hypot(du, dv);
+        if (r <= 0) continue;
+        const double max_across = kMaxAcrossFraction * r;
+        if (run(hall, u, v, -dv / r, du / r, max_across) <= max_across) narrow.at<uint8_t>(v, u) = 1;
+      }
+    }
+    for (int v = 0; v < height; ++v) {
+      for (int u = 0; u < width; ++u) {
+        if (!narrow.at<uint8_t>(v, u)) continue;
+        const double du = u - cal.center_u, dv = v - cal.center_v;
+        const double r = std::hypot(du, dv);
+        if (run(narrow, u, v, du / r, dv / r, min_run) >= min_run) mask.at<uint8_t>(v, u) = 255;
+      }
+    }
     const cv::Mat seeds = mask.clone();
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {

@@ -127,7 +127,7 @@ std::vector<EvalMode> evalModes(bool ablations) {
   return modes;
 }
 
-std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses) {
+std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses, bool turning) {
   if (scene.scenario.frames.empty()) return {};
   core::Calibration calibration = scene.calibration;
   calibration.camera.self_mask.clear();
@@ -148,6 +148,7 @@ std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses) {
   };
   for (int k = 0, tries = 0; k < poses && tries < 50 * poses; ++tries) {
     core::Pose2D pose{x(rng), y(rng), theta(rng)};
+    if (!turning) pose.theta_rad = 0.0;
     if (!free(pose.x_m, pose.y_m)) continue;
     drive.robot_pose = pose;
     drive.noise_seed = 5000u + static_cast<uint32_t>(k);

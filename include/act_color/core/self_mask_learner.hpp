@@ -49,6 +49,11 @@ class SelfMaskLearner {
   // kConstantSd: sensor noise and light that differs a little from place to place.
   static constexpr double kCarpetLevel = 100.0;
   static constexpr double kConstantSd = 15.0;
+  // A part over the hall only is at most this fraction of its distance from the centre wide, and
+  // is looked for once the poses counted faced kMinHeadingSectors of kHeadingSectors directions.
+  static constexpr double kMaxAcrossFraction = 0.15;
+  static constexpr unsigned kHeadingSectors = 8;
+  static constexpr size_t kMinHeadingSectors = 4;
 
  private:
   Calibration calibration_;
@@ -61,6 +66,7 @@ class SelfMaskLearner {
   std::vector<double> color_sum_sq_;
   int frames_ = 0;
   Pose2D last_pose_;
+  uint32_t heading_sectors_ = 0;  // bit k: a pose counted faced sector k
 };
 
 }  // namespace core

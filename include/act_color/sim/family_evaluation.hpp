@@ -33,10 +33,11 @@ enum class SelfMaskSource { kNone, kStruts, kLearnedOnDrive };
 // frame's hall, robots, ball and light seen from `poses` random poses on the field (told exactly),
 // a default ActTrainer without a mask trained along (bootstrapped at the first pose, then
 // kDriveCyclesPerPose cycles at each) and core::SelfMaskLearner fed the table after each pose's
-// cycles. Deterministic in the scene's seed.
+// cycles. Deterministic in the scene's seed. `turning` false: every pose faces +x (a drive that
+// never turns).
 constexpr int kDrivePoses = 24;
 constexpr int kDriveCyclesPerPose = 5;
-std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses);
+std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses, bool turning = true);
 
 struct EvalOptions {
   size_t adapt_frames = 12;    // frames of each segment before "after adaptation"
