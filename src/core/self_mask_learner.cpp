@@ -31,6 +31,19 @@ constexpr int kAttachedPx = 2;
 // A pixel must have been looked at in this fraction of the frames (at least 1).
 constexpr double kMinLookedFraction = 0.3;
 
+// The pixels of `set` (CV_8UC1, nonzero) in an unbroken row through (u, v) along (ex, ey), both
+// ways, in steps of one pixel; counting stops once it passes `limit`.
+double runThrough(const cv::Mat& set, int u, int v, double ex, double ey, double limit) {
+  auto in = [&](double x, double y) {
+    const int iu = static_cast<int>(std::lround(x)), iv = static_cast<int>(std::lround(y));
+    return iu >= 0 && iv >= 0 && iu < set.cols && iv < set.rows && set.at<uint8_t>(iv, iu) != 0;
+  };
+  double length = 1;
+  for (double s = 1; length <= limit && in(u + s * ex, v + s * ey); ++s) ++length;
+  for (double s = 1; length <= limit && in(u - s * ex, v - s * ey); ++s) ++length;
+  return length;
+}
+
 }  // namespace
 
 SelfMaskLearner::SelfMaskLearner(const Calibration& calibration)
@@ -115,10 +128,6 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
   const double ring = std::max(1.0, cal.mirror_radius_px - cal.chassis_radius_px);
   const double min_run = kMinRadialFraction * ring;
   const double chassis_ring = cal.chassis_radius_px + kChassisRingFraction * ring + kChassisTouchPx;
-  auto candidate = [&](double u, double v) {
-    const int iu = static_cast<int>(std::lround(u)), iv = static_cast<int>(std::lround(v));
-    return iu >= 0 && iv >= 0 && iu < width && iv < height && candidates.at<uint8_t>(iv, iu) != 0;
-  };
   cv::Mat mask(height, width, CV_8UC1, cv::Scalar(0));
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
@@ -127,12 +136,8 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
       const double r = std::hypot(du, dv);
       bool own = r <= chassis_ring;
       if (!own && r > 0) {
-        // The run of candidates through this pixel along its ray, in steps of one pixel.
-        const double ex = du / r, ey = dv / r;
-        double run = 1;
-        for (double s = 1; run < min_run && candidate(u + s * ex, v + s * ey); ++s) ++run;
-        for (double s = 1; run < min_run && candidate(u - s * ex, v - s * ey); ++s) ++run;
-        own = run >= min_run;
+        // The run of candidates through this pixel along its ray.
+        own = runThrough(candidates, u, v, du / r, dv / r, min_run) >= min_run;
       }
       if (own) mask.at<uint8_t>(v, u) = 255;
     }
@@ -190,16 +195,6 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
           hall.at<uint8_t>(v, u) = 1;
       }
     }
-    auto run = [&](const cv::Mat& set, int u, int v, double ex, double ey, double limit) {
-      auto in = [&](double x, double y) {
-        const int iu = static_cast<int>(std::lround(x)), iv = static_cast<int>(std::lround(y));
-        return iu >= 0 && iv >= 0 && iu < width && iv < height && set.at<uint8_t>(iv, iu) != 0;
-      };
-      double length = 1;
-      for (double s = 1; length <= limit && in(u + s * ex, v + s * ey); ++s) ++length;
-      for (double s = 1; length <= limit && in(u - s * ex, v - s * ey); ++s) ++length;
-      return length;
-    };
     cv::Mat narrow(height, width, CV_8UC1, cv::Scalar(0));
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
@@ -208,7 +203,7 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
         const double r = std::hypot(du, dv);
         if (r <= 0) continue;
         const double max_across = kMaxAcrossFraction * r;
-        if (run(hall, u, v, -dv / r, du / r, max_across) <= max_across) narrow.at<uint8_t>(v, u) = 1;
+        if (runThrough(hall, u, v, -dv / r, du / r, max_across) <= max_across) narrow.at<uint8_t>(v, u) = 1;
       }
     }
     for (int v = 0; v < height; ++v) {
@@ -216,7 +211,7 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
         if (!narrow.at<uint8_t>(v, u)) continue;
         const double du = u - cal.center_u, dv = v - cal.center_v;
         const double r = std::hypot(du, dv);
-        if (run(narrow, u, v, du / r, dv / r, min_run) >= min_run) mask.at<uint8_t>(v, u) = 255;
+        if (runThrough(narrow, u, v, du / r, dv / r, min_run) >= min_run) mask.at<uint8_t>(v, u) = 255;
       }
     }
     const cv::Mat seeds = mask.clone();
