@@ -164,37 +164,32 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
   // Where a part runs on beyond the field, along the radius through the pixels nothing was
   // expected at (or that showed neither carpet nor line) as long as they keep their color.
   if (frames_ >= kMinPosesForConstancy) {
+    // Open to the walk: imaged pixels past the chassis, nothing expected at them (or candidates),
+    // that keep their color; `hall`: those nothing was expected at.
     const double n = frames_;
-    auto constant = [&](size_t i) {
-      double mean_sq = 0;
-      for (int ch = 0; ch < 3; ++ch) {
-        const double m = color_sum_[3 * i + ch] / n;
-        mean_sq += m * m;
-      }
-      return (color_sum_sq_[i] / n - mean_sq) / 3.0 <= kConstantSd * kConstantSd;
-    };
-    auto open = [&](int u, int v) {
-      if (u < 0 || v < 0 || u >= width || v >= height) return false;
-      const size_t i = static_cast<size_t>(v) * width + u;
-      const PixelRegion region = camera.ray(i).region;
-      if (region == PixelRegion::kNotImaged || region == PixelRegion::kChassis) return false;
-      return (looked_[i] < min_looked || candidates.at<uint8_t>(v, u)) && constant(i);
-    };
-    // A part that lies over the hall only: a long run along the radius of pixels nothing was
-    // expected at that keep their color, narrow across it (a wall or ceiling of one color keeps
-    // its color too, but all round). Only once the robot has faced kMinHeadingSectors directions:
-    // driving straight on, a pole far to the side stays at its pixels too.
-    const bool turned = std::bitset<kHeadingSectors>(heading_sectors_).count() >= kMinHeadingSectors;
-    cv::Mat hall(height, width, CV_8UC1, cv::Scalar(0));
+    cv::Mat open(height, width, CV_8UC1, cv::Scalar(0)), hall(height, width, CV_8UC1, cv::Scalar(0));
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
         const size_t i = static_cast<size_t>(v) * width + u;
         const PixelRegion region = camera.ray(i).region;
-        if (turned && region != PixelRegion::kNotImaged && region != PixelRegion::kChassis && looked_[i] < min_looked &&
-            constant(i))
-          hall.at<uint8_t>(v, u) = 1;
+        if (region == PixelRegion::kNotImaged || region == PixelRegion::kChassis) continue;
+        const bool unexpected = looked_[i] < min_looked;
+        if (!unexpected && !candidates.at<uint8_t>(v, u)) continue;
+        double mean_sq = 0;
+        for (int ch = 0; ch < 3; ++ch) {
+          const double m = color_sum_[3 * i + ch] / n;
+          mean_sq += m * m;
+        }
+        if ((color_sum_sq_[i] / n - mean_sq) / 3.0 > kConstantSd * kConstantSd) continue;
+        open.at<uint8_t>(v, u) = 1;
+        hall.at<uint8_t>(v, u) = unexpected;
       }
     }
+    // A part that lies over the hall only: a long run along the radius of pixels nothing was
+    // expected at that keep their color, narrow across it (a wall or ceiling of one color keeps
+    // its color too, but all round). Only once the robot has faced kMinHeadingSectors directions:
+    // driving straight on, a pole far to the side stays at its pixels too.
+    if (std::bitset<kHeadingSectors>(heading_sectors_).count() < kMinHeadingSectors) hall.setTo(0);
     cv::Mat narrow(height, width, CV_8UC1, cv::Scalar(0));
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
@@ -226,7 +221,7 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
           for (double s = 1;; ++s) {
             const int gu = static_cast<int>(std::lround(u + dir * s * ex)),
                       gv = static_cast<int>(std::lround(v + dir * s * ey));
-            if (!open(gu, gv)) break;
+            if (gu < 0 || gv < 0 || gu >= width || gv >= height || !open.at<uint8_t>(gv, gu)) break;
             mask.at<uint8_t>(gv, gu) = 255;
           }
         }
