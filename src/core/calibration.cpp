@@ -429,21 +429,34 @@ std::string toYaml(const Calibration& calibration) {
   return s.str();
 }
 
-void saveSelfMask(const CameraCalibration& camera, const std::string& path) {
+std::vector<uint8_t> encodeSelfMask(const CameraCalibration& camera) {
   if (camera.self_mask.size() != static_cast<size_t>(camera.width) * camera.height)
-    throw CalibrationError(path + ": the self mask does not match the camera's size");
+    throw CalibrationError("the self mask does not match the camera's size");
   cv::Mat image(camera.height, camera.width, CV_8UC1);
   for (int v = 0; v < camera.height; ++v) {
     for (int u = 0; u < camera.width; ++u)
       image.at<uint8_t>(v, u) = camera.self_mask[static_cast<size_t>(v) * camera.width + u] ? 255 : 0;
   }
-  bool written = false;
+  std::vector<uint8_t> png;
+  bool encoded = false;
   try {
-    written = cv::imwrite(path, image);
+    encoded = cv::imencode(".png", image, png);
   } catch (const cv::Exception&) {
-    written = false;
+    encoded = false;
   }
-  if (!written) throw CalibrationError(path + ": cannot write the self mask");
+  if (!encoded) throw CalibrationError("cannot encode the self mask as a PNG");
+  return png;
+}
+
+void saveSelfMask(const CameraCalibration& camera, const std::string& path) {
+  std::vector<uint8_t> png;
+  try {
+    png = encodeSelfMask(camera);
+  } catch (const CalibrationError& e) {
+    throw CalibrationError(path + ": " + e.what());
+  }
+  std::string error;
+  if (!writeFileAtomically(path, png.data(), png.size(), &error)) throw CalibrationError(error);
 }
 
 bool PoseBounds::contains(double x_m, double y_m, std::string* why) const {

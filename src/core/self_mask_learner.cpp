@@ -55,16 +55,18 @@ SelfMaskLearner::SelfMaskLearner(const Calibration& calibration)
   color_sum_sq_.assign(pixels, 0.0);
 }
 
+bool SelfMaskLearner::isNewPose(const Pose2D& last, const Pose2D& pose) {
+  const double moved = std::hypot(pose.x_m - last.x_m, pose.y_m - last.y_m);
+  const double turned = std::abs(std::remainder(pose.theta_rad - last.theta_rad, 2 * M_PI));
+  return moved >= kMinMoveM || turned >= kMinTurnRad;
+}
+
 void SelfMaskLearner::add(const ImageView& image, const Pose2D& pose, const ColorLut& lut) {
   const auto& camera = model_.camera();
   if (image.width != camera.width() || image.height != camera.height())
     throw std::invalid_argument("image size does not match the calibration");
   if (!pose.isFinite()) throw std::invalid_argument("pose is not finite");
-  if (frames_ > 0) {
-    const double moved = std::hypot(pose.x_m - last_pose_.x_m, pose.y_m - last_pose_.y_m);
-    const double turned = std::abs(std::remainder(pose.theta_rad - last_pose_.theta_rad, 2 * M_PI));
-    if (moved < kMinMoveM && turned < kMinTurnRad) return;
-  }
+  if (frames_ > 0 && !isNewPose(last_pose_, pose)) return;
   if (frames_ == std::numeric_limits<uint16_t>::max()) return;  // the counts are full
   last_pose_ = pose;
   ++frames_;

@@ -39,6 +39,7 @@
 #include "act_color/ros/lut_file.hpp"
 #include "act_color/ros/nodelet_setup.hpp"
 #include "act_color/ros/pose_source.hpp"
+#include "act_color/ros/self_mask_worker.hpp"
 
 namespace act_color {
 
@@ -93,6 +94,9 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool requestPath(const FilePath::Request& req, FilePath::Response& res, std::string* path) const;
   bool onSaveLut(FilePath::Request& req, FilePath::Response& res);
   bool onLoadLut(FilePath::Request& req, FilePath::Response& res);
+  // ~save_self_mask: the own robot's pixels learned so far (~learn_self_mask) as a PNG inside
+  // ~lut_dir, for the calibration's camera.self_mask.
+  bool onSaveSelfMask(FilePath::Request& req, FilePath::Response& res);
   // A table file: saveLut = prepareSave (the table and ~lut_dir, under the lock) + writeTable (the
   // file inside ~lut_dir and its I/O: every file system call); loadLut = loadPath + readTable (the
   // file I/O alone) + installTable (under the lock). The services run the I/O parts with a timeout.
@@ -123,7 +127,7 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   // the manager when the queue went first).
   ros::CallbackQueue io_queue_;
   std::unique_ptr<ros::AsyncSpinner> io_spinner_;
-  ros::ServiceServer save_srv_, load_srv_;
+  ros::ServiceServer save_srv_, load_srv_, save_self_mask_srv_;
   std::unique_ptr<ros_conversions::CheckedReconfigure<ActTrainerConfig>> reconfigure_;
   std::unique_ptr<diagnostic_updater::Updater> updater_;
   ros::WallTimer diagnostics_timer_, drain_timer_, table_image_timer_;
@@ -146,6 +150,9 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   std::string lut_dir_;                             // saves only inside it
   std::optional<core::PixelFormat> camera_format_;  // of the last usable image
   bool save_on_shutdown_ = false;
+  bool learn_self_mask_ = false;
+  // ~learn_self_mask: made with the trainer (loadCalibration), fed by trainOn.
+  std::shared_ptr<ros_conversions::SelfMaskWorker> self_mask_;
   bool reset_on_time_jump_ = false;
   bool debug_addresses_ = false;
   double max_pose_age_s_ = 1.0;
@@ -183,6 +190,7 @@ ActTrainerNodelet::~ActTrainerNodelet() {
   if (io_spinner_) io_spinner_->stop();
   save_srv_.shutdown();
   load_srv_.shutdown();
+  save_self_mask_srv_.shutdown();
   // ~save_on_shutdown: the table of this run survives the robot's restart. Never throws.
   try {
     std::string path, message;
@@ -281,7 +289,8 @@ bool ActTrainerNodelet::configure(std::string* error) {
     initial_pose_ = p;
   }
   int bootstrap_cycles = core::kDefaultBootstrapCycles;
-  bool bootstrap_at_first_pose = false, save_on_shutdown = false, reset_on_time_jump = false, debug = false;
+  bool bootstrap_at_first_pose = false, save_on_shutdown = false, reset_on_time_jump = false, debug = false,
+       learn_self_mask = false;
   double tf_timeout = tf_timeout_s_, throttled_period = lut_throttled_period_s_, max_pose_age = max_pose_age_s_;
   int publish_every = publish_lut_every_;
   std::string lut_file, load_path, lut_dir, base_frame = "base_link", field_frame = "field";
@@ -289,6 +298,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
       !readParam(pnh_, "bootstrap_at_first_pose", &bootstrap_at_first_pose, error) ||
       !readParam(pnh_, "lut_file", &lut_file, error) || !readParam(pnh_, "load_lut", &load_path, error) ||
       !readParam(pnh_, "lut_dir", &lut_dir, error) || !readParam(pnh_, "save_on_shutdown", &save_on_shutdown, error) ||
+      !readParam(pnh_, "learn_self_mask", &learn_self_mask, error) ||
       !readParam(pnh_, "reset_on_time_jump", &reset_on_time_jump, error) ||
       !readParam(pnh_, "tf_timeout", &tf_timeout, error) || !readParam(pnh_, "max_pose_age", &max_pose_age, error) ||
       !readParam(pnh_, "publish_lut_every", &publish_every, error) ||
@@ -326,6 +336,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
     lut_file_ = lut_file;
     lut_dir_ = lut_dir;
     save_on_shutdown_ = save_on_shutdown;
+    learn_self_mask_ = learn_self_mask;
     reset_on_time_jump_ = reset_on_time_jump;
     debug_addresses_ = debug;
     base_frame_ = base_frame;
@@ -373,6 +384,7 @@ bool ActTrainerNodelet::configure(std::string* error) {
     io.setCallbackQueue(&io_queue_);
     save_srv_ = io.advertiseService("save_lut", &ActTrainerNodelet::onSaveLut, this);
     load_srv_ = io.advertiseService("load_lut", &ActTrainerNodelet::onLoadLut, this);
+    save_self_mask_srv_ = io.advertiseService("save_self_mask", &ActTrainerNodelet::onSaveSelfMask, this);
     io_spinner_ = std::make_unique<ros::AsyncSpinner>(1, &io_queue_);
     io_spinner_->start();
   }
@@ -412,10 +424,17 @@ void ActTrainerNodelet::loadCalibration(const core::ActParams& params, const std
   // The camera model of every pixel: the part that grows with the image.
   auto trainer = std::make_unique<core::ActTrainer>(calibration, params);
   auto segmenter = std::make_unique<core::Segmenter>(calibration.camera);
+  bool learn_self_mask = false;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    learn_self_mask = learn_self_mask_;
+  }
+  auto self_mask = learn_self_mask ? std::make_shared<ros_conversions::SelfMaskWorker>(calibration) : nullptr;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     trainer_ = std::move(trainer);
     segmenter_ = std::move(segmenter);
+    self_mask_ = std::move(self_mask);
     params_changed_ = true;  // ~dynamic_reconfigure may have changed them while loading
   }
   if (!load_path.empty()) {
@@ -432,13 +451,15 @@ void ActTrainerNodelet::loadCalibration(const core::ActParams& params, const std
     std::lock_guard<std::mutex> lock(mutex_);
     has_table = has_table_;
   }
-  NODELET_INFO("ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s", calibration_path.c_str(),
-               calibration.camera.width, calibration.camera.height,
-               pose_source_.mode() == ros_conversions::PoseSource::Mode::kTf ? "tf" : "topic",
-               has_table                  ? "loaded"
-               : initial_pose_            ? "bootstrap at ~initial_pose"
-               : bootstrap_at_first_pose_ ? "bootstrap at the first localization pose"
-                                          : "none (trained online)");
+  NODELET_INFO(
+      "ACT trainer ready: calibration %s (%dx%d), pose from %s, start-up table: %s%s", calibration_path.c_str(),
+      calibration.camera.width, calibration.camera.height,
+      pose_source_.mode() == ros_conversions::PoseSource::Mode::kTf ? "tf" : "topic",
+      has_table                  ? "loaded"
+      : initial_pose_            ? "bootstrap at ~initial_pose"
+      : bootstrap_at_first_pose_ ? "bootstrap at the first localization pose"
+                                 : "none (trained online)",
+      learn_self_mask ? "; learning the own robot's pixels (~learn_self_mask; ~save_self_mask saves them)" : "");
 }
 
 std::string ActTrainerNodelet::notReady() const {
@@ -642,6 +663,8 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
   } else if (have_pose) {
     last_stats_ = trainer_->cycle(view, pose);
     outcome = last_stats_.pose_contradicted ? Outcome::kContradicted : Outcome::kTrained;
+    // The table after this frame's cycle classifies the frame for the self mask (as act_replay's).
+    if (self_mask_ && outcome == Outcome::kTrained) self_mask_->offer(msg, pose, trainer_->lut());
     if (last_stats_.pose_contradicted) {
       ++contradicted_;
       ACT_WALL_THROTTLE(5.0, NODELET_WARN("no training on the image stamped %.3f: %.0f%% of its samples contradict the "
@@ -969,6 +992,66 @@ bool ActTrainerNodelet::onLoadLut(FilePath::Request& req, FilePath::Response& re
   return true;
 }
 
+bool ActTrainerNodelet::onSaveSelfMask(FilePath::Request& req, FilePath::Response& res) {
+  std::shared_ptr<ros_conversions::SelfMaskWorker> worker;
+  std::string lut_dir;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    worker = self_mask_;
+    lut_dir = lut_dir_;
+    res.success = false;
+    if (!learn_self_mask_) {
+      res.message = "~learn_self_mask is off: nothing is learned";
+    } else if (!trainer_) {
+      res.message = notReady();
+    }
+  }
+  if (worker) {
+    const int poses = worker->poses();
+    const core::CameraCalibration camera = worker->learned();
+    if (poses == 0) {
+      res.message = "no frame counted yet: the self mask is learned from trained frames at distinct poses";
+      const std::string error = worker->lastError();
+      if (!error.empty()) res.message += " (the last one failed: " + error + ")";
+    } else {
+      const std::string requested = req.path.empty() ? "self_mask.png" : req.path;
+      std::shared_ptr<const std::vector<uint8_t>> png;
+      try {
+        png = std::make_shared<const std::vector<uint8_t>>(core::encodeSelfMask(camera));
+      } catch (const std::exception& e) {
+        res.message = e.what();
+      }
+      auto shared_path = std::make_shared<std::string>();
+      res.success = png && withTimeout(
+                               [png, lut_dir, requested, shared_path](std::string* m) {
+                                 return ros_conversions::lutPathInside(lut_dir, requested, shared_path.get(), m) &&
+                                        ros_conversions::savePngFile(*png, *shared_path, m);
+                               },
+                               kFileTimeoutS, &res.message);
+      if (res.success) {
+        size_t pixels = 0;
+        for (uint8_t m : camera.self_mask) pixels += m;
+        std::ostringstream m;
+        m.precision(3);
+        m << "saved the self mask learned from " << poses << " distinct poses (" << pixels << " pixels, "
+          << 100.0 * static_cast<double>(pixels) / static_cast<double>(camera.self_mask.size()) << "% of the image) to "
+          << *shared_path << ": set 'self_mask: " << *shared_path << "' in the calibration's camera section";
+        if (poses < core::SelfMaskLearner::kMinPosesForConstancy) {
+          m << "; fewer than " << core::SelfMaskLearner::kMinPosesForConstancy
+            << " distinct poses, so struts are not yet followed over the hall: drive and turn on, then save again";
+        }
+        res.message = m.str();
+      }
+    }
+  }
+  if (res.success) {
+    NODELET_INFO("~save_self_mask: %s", res.message.c_str());
+  } else {
+    NODELET_ERROR("~save_self_mask: %s", res.message.c_str());
+  }
+  return true;
+}
+
 void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status) {
   using diagnostic_msgs::DiagnosticStatus;
   std::lock_guard<std::mutex> lock(mutex_);
@@ -1071,6 +1154,12 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("last rejection", last_reject_reason_);
   status.add("poses rejected", pose_source_.rejected());
   status.add("time jumps back", time_jumps_);
+  if (self_mask_) {
+    status.add("self mask learned from (distinct poses)", self_mask_->poses());
+    status.add("self mask: last pose counted in (ms, own thread)", self_mask_->lastMs());
+    const std::string error = self_mask_->lastError();
+    if (!error.empty()) status.add("self mask: last frame not counted", error);
+  }
   status.add("table revision", trainer_->revision());
   status.add("table fill (%)", fill_percent);
   const bool yellow_absent = trainer_->goalAbsent(core::kYellow), blue_absent = trainer_->goalAbsent(core::kBlue);

@@ -24,17 +24,32 @@ constexpr size_t kClusterBytes = 1 + 3 * 4 + 4 + 4 + 4;  // ClassCluster: class_
 constexpr uint32_t kMaxFrameIdBytes = 1024;
 constexpr uint32_t kMaxClusters = 64;
 
-// True when the regular file at `path` begins with the magic line (reads only that).
-bool startsAsTableFile(const std::string& path) {
+// True when the regular file at `path` begins with the `n` bytes of `magic` (reads only those).
+bool startsWith(const std::string& path, const char* magic, size_t n) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return false;
   struct stat st {};
-  char head[kMagicBytes];
+  std::vector<char> head(n);
   const bool ok = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) &&
-                  ::read(fd, head, kMagicBytes) == static_cast<ssize_t>(kMagicBytes) &&
-                  std::memcmp(head, kLutFileMagic, kMagicBytes) == 0;
+                  ::read(fd, head.data(), n) == static_cast<ssize_t>(n) && std::memcmp(head.data(), magic, n) == 0;
   ::close(fd);
   return ok;
+}
+
+// False (and `error` set) when `path` is no file name, or names something that exists and is not a
+// regular file beginning with `magic` (`what` it holds): a save replaces only what it wrote before.
+bool mayReplace(const std::string& path, const char* magic, size_t n, const std::string& what, std::string* error) {
+  if (path.empty() || path.find('\0') != std::string::npos) {
+    *error = "not a file name: '" + path + "'";
+    return false;
+  }
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(path, ec);
+  if (fs::exists(status) && !(fs::is_regular_file(status) && startsWith(path, magic, n))) {
+    *error = "'" + path + "' exists and is not " + what + ": not overwritten";
+    return false;
+  }
+  return true;
 }
 
 // Walks the serialized ColorLut (Header, color_space, bits, revision, table, clusters) checking
@@ -76,17 +91,7 @@ std::string checkLayout(const uint8_t* p, size_t size) {
 }  // namespace
 
 bool saveLutFile(const act_color::ColorLut& msg, const std::string& path, std::string* error) {
-  if (path.empty() || path.find('\0') != std::string::npos) {
-    *error = "not a file name: '" + path + "'";
-    return false;
-  }
-  std::error_code ec;
-  const fs::file_status status = fs::symlink_status(path, ec);
-  if (fs::exists(status) && !(fs::is_regular_file(status) && startsAsTableFile(path))) {
-    // Replace only what is a table already.
-    *error = "'" + path + "' exists and is not a color table file: not overwritten";
-    return false;
-  }
+  if (!mayReplace(path, kLutFileMagic, kMagicBytes, "a color table file", error)) return false;
   const uint32_t size = ::ros::serialization::serializationLength(msg);
   std::vector<uint8_t> buffer(kMagicBytes + size);
   std::memcpy(buffer.data(), kLutFileMagic, kMagicBytes);
@@ -94,6 +99,12 @@ bool saveLutFile(const act_color::ColorLut& msg, const std::string& path, std::s
   ::ros::serialization::serialize(stream, msg);
 
   return core::writeFileAtomically(path, buffer.data(), buffer.size(), error);
+}
+
+bool savePngFile(const std::vector<uint8_t>& png, const std::string& path, std::string* error) {
+  static constexpr char kPngSignature[] = "\x89PNG\r\n\x1a\n";
+  if (!mayReplace(path, kPngSignature, sizeof(kPngSignature) - 1, "a PNG image", error)) return false;
+  return core::writeFileAtomically(path, png.data(), png.size(), error);
 }
 
 bool loadLutFile(const std::string& path, act_color::ColorLut* msg, std::string* error) {

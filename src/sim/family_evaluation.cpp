@@ -127,6 +127,29 @@ std::vector<EvalMode> evalModes(bool ablations) {
   return modes;
 }
 
+std::vector<core::Pose2D> drivePoses(const FamilyScene& scene, int poses, bool turning) {
+  std::vector<core::Pose2D> drive;
+  if (scene.scenario.frames.empty()) return drive;
+  const Scene& first = scene.scenario.frames.front().scene;
+  const core::FieldCalibration& field = scene.calibration.field;
+  std::mt19937 rng(scene.seed * 7919u + 17u);
+  const double half_x = 0.45 * field.length_m, half_y = 0.45 * field.width_m;
+  std::uniform_real_distribution<double> x(-half_x, half_x), y(-half_y, half_y), theta(-M_PI, M_PI);
+  // Where the own robot (some 0.25 m in radius) can stand: off the other robots and the ball.
+  auto free = [&](double px, double py) {
+    for (const RobotObstacle& r : first.robots) {
+      if (std::hypot(px - r.x_m, py - r.y_m) < r.radius_m + 0.3) return false;
+    }
+    return !first.ball || std::hypot(px - first.ball->x_m, py - first.ball->y_m) >= 0.4;
+  };
+  for (int tries = 0; static_cast<int>(drive.size()) < poses && tries < 50 * poses; ++tries) {
+    core::Pose2D pose{x(rng), y(rng), theta(rng)};
+    if (!turning) pose.theta_rad = 0.0;
+    if (free(pose.x_m, pose.y_m)) drive.push_back(pose);
+  }
+  return drive;
+}
+
 std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses, bool turning) {
   if (scene.scenario.frames.empty()) return {};
   core::Calibration calibration = scene.calibration;
@@ -136,28 +159,15 @@ std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses, b
   core::ActTrainer trainer(calibration, core::ActParams());
   core::SelfMaskLearner learner(calibration);
   Scene drive = scene.scenario.frames.front().scene;
-  std::mt19937 rng(scene.seed * 7919u + 17u);
-  const double half_x = 0.45 * calibration.field.length_m, half_y = 0.45 * calibration.field.width_m;
-  std::uniform_real_distribution<double> x(-half_x, half_x), y(-half_y, half_y), theta(-M_PI, M_PI);
-  // Where the own robot (some 0.25 m in radius) can stand: off the other robots and the ball.
-  auto free = [&](double px, double py) {
-    for (const RobotObstacle& r : drive.robots) {
-      if (std::hypot(px - r.x_m, py - r.y_m) < r.radius_m + 0.3) return false;
-    }
-    return !drive.ball || std::hypot(px - drive.ball->x_m, py - drive.ball->y_m) >= 0.4;
-  };
-  for (int k = 0, tries = 0; k < poses && tries < 50 * poses; ++tries) {
-    core::Pose2D pose{x(rng), y(rng), theta(rng)};
-    if (!turning) pose.theta_rad = 0.0;
-    if (!free(pose.x_m, pose.y_m)) continue;
-    drive.robot_pose = pose;
-    drive.noise_seed = 5000u + static_cast<uint32_t>(k);
+  const std::vector<core::Pose2D> at = drivePoses(scene, poses, turning);
+  for (size_t k = 0; k < at.size(); ++k) {
+    drive.robot_pose = at[k];
+    drive.noise_seed = kDriveNoiseSeed + static_cast<uint32_t>(k);
     const LabeledFrame frame = renderer.render(drive);
     const core::ImageView view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
-    if (k == 0) trainer.bootstrap(view, pose, core::kDefaultBootstrapCycles);
-    for (int c = 0; c < kDriveCyclesPerPose; ++c) trainer.cycle(view, pose);
-    learner.add(view, pose, trainer.lut());
-    ++k;
+    if (k == 0) trainer.bootstrap(view, at[k], core::kDefaultBootstrapCycles);
+    for (int c = 0; c < kDriveCyclesPerPose; ++c) trainer.cycle(view, at[k]);
+    learner.add(view, at[k], trainer.lut());
   }
   return learner.mask();
 }

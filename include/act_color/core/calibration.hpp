@@ -104,8 +104,12 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
 // YAML text in the contract's format; parseCalibration(toYaml(c)) == c (the self mask's file name
 // is written, its pixels are saved with saveSelfMask).
 std::string toYaml(const Calibration& calibration);
-// Writes camera.self_mask as a PNG (255 = own robot) to `path`; throws CalibrationError when it
-// cannot. The file `self_mask_file` names is resolved against the calibration file's directory.
+// camera.self_mask as the bytes of a PNG (255 = own robot); throws CalibrationError when the mask
+// does not match the camera's size.
+std::vector<uint8_t> encodeSelfMask(const CameraCalibration& camera);
+// Writes encodeSelfMask(camera) to `path` atomically (a temporary file beside it, renamed over it);
+// throws CalibrationError when it cannot. The file `self_mask_file` names is resolved against the
+// calibration file's directory.
 void saveSelfMask(const CameraCalibration& camera, const std::string& path);
 
 }  // namespace core

@@ -37,6 +37,9 @@ class SelfMaskLearner {
 
   // Frames counted so far (distinct poses).
   int frames() const { return frames_; }
+  // Whether add() counts a frame at `pose` after one counted at `last`: it moved kMinMoveM or
+  // turned kMinTurnRad (a caller can tell before it copies a frame and its table for add()).
+  static bool isNewPose(const Pose2D& last, const Pose2D& pose);
   // The mask (row-major, 1 = own robot); empty before any frame was counted.
   std::vector<uint8_t> mask() const;
 

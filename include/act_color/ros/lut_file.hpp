@@ -1,7 +1,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "act_color/ColorLut.h"
 
@@ -18,6 +20,10 @@ constexpr size_t kMaxLutFileBytes = (size_t{1} << 24) + 4096;
 // full disk never leaves half a table. An existing `path` is replaced only when it is a regular
 // file that already holds a color table (never truncates an unrelated file). False with a reason.
 bool saveLutFile(const act_color::ColorLut& msg, const std::string& path, std::string* error);
+
+// Writes the bytes of a PNG image (a learned self mask) atomically, as saveLutFile: an existing
+// `path` is replaced only when it is a regular file that is a PNG. False with a reason.
+bool savePngFile(const std::vector<uint8_t>& png, const std::string& path, std::string* error);
 
 // Reads a file written by saveLutFile: a regular file of at most kMaxLutFileBytes, whose every
 // length field is checked against the bytes there before anything is allocated for it (a forged

@@ -38,6 +38,11 @@ enum class SelfMaskSource { kNone, kStruts, kLearnedOnDrive };
 constexpr int kDrivePoses = 24;
 constexpr int kDriveCyclesPerPose = 5;
 std::vector<uint8_t> learnSelfMaskOnDrive(const FamilyScene& scene, int poses, bool turning = true);
+// The drive's poses: `poses` random poses within 0.45 of the field's length and width, off the
+// first frame's robots and ball (fewer when the field is crowded). The frame at pose k is rendered
+// with noise seed kDriveNoiseSeed + k.
+std::vector<core::Pose2D> drivePoses(const FamilyScene& scene, int poses, bool turning = true);
+constexpr uint32_t kDriveNoiseSeed = 5000;
 
 struct EvalOptions {
   size_t adapt_frames = 12;    // frames of each segment before "after adaptation"

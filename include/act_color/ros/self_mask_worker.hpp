@@ -1,0 +1,71 @@
+#pragma once
+
+#include <sensor_msgs/Image.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "act_color/core/calibration.hpp"
+#include "act_color/core/color_lut.hpp"
+#include "act_color/core/self_mask_learner.hpp"
+#include "act_color/core/types.hpp"
+
+namespace act_color {
+namespace ros_conversions {
+
+// The own robot's pixels learned while it drives (the trainer's ~learn_self_mask): a
+// core::SelfMaskLearner on a thread of its own. The trainer offers each frame it trained; the
+// worker takes one only when it is idle and the pose is new to the learner
+// (SelfMaskLearner::isNewPose), and only then copies the table. Training never waits for it: a
+// frame offered while one is being counted is passed over (the next new pose comes soon).
+class SelfMaskWorker {
+ public:
+  explicit SelfMaskWorker(const core::Calibration& calibration);
+  SelfMaskWorker(const SelfMaskWorker&) = delete;
+  SelfMaskWorker& operator=(const SelfMaskWorker&) = delete;
+  // Waits for the frame being counted, if any.
+  ~SelfMaskWorker();
+
+  // True when the frame was taken. The image message is kept (not copied) until it is counted.
+  bool offer(const sensor_msgs::ImageConstPtr& image, const core::Pose2D& pose, const core::ColorLut& lut);
+  // Distinct poses counted so far.
+  int poses() const;
+  // The camera with the mask learned so far as its self mask (self_mask empty before any pose).
+  // Waits for a frame being counted.
+  core::CameraCalibration learned() const;
+  // Why the last frame could not be counted ("" when it was).
+  std::string lastError() const;
+  // How long counting the last frame took (ms, on the worker's thread; 0 before any).
+  double lastMs() const;
+
+ private:
+  struct Job {
+    sensor_msgs::ImageConstPtr image;
+    core::Pose2D pose;
+    core::ColorLut lut;
+  };
+  void run();
+
+  const core::CameraCalibration camera_;
+  // The learner, under learner_mutex_ (held while a frame is counted).
+  mutable std::mutex learner_mutex_;
+  core::SelfMaskLearner learner_;
+  // The hand-over, under mutex_.
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::optional<Job> job_;
+  bool busy_ = false, stop_ = false;
+  std::optional<core::Pose2D> last_taken_;
+  int poses_ = 0;
+  double last_ms_ = 0.0;
+  std::string last_error_;
+  std::thread thread_;  // last: starts once everything above is built
+};
+
+}  // namespace ros_conversions
+}  // namespace act_color

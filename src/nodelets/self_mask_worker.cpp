@@ -1,0 +1,89 @@
+#include "act_color/ros/self_mask_worker.hpp"
+
+#include "act_color/core/image_view.hpp"
+#include "act_color/ros/conversions.hpp"
+
+namespace act_color {
+namespace ros_conversions {
+
+SelfMaskWorker::SelfMaskWorker(const core::Calibration& calibration)
+    : camera_(calibration.camera), learner_(calibration), thread_([this] { run(); }) {}
+
+SelfMaskWorker::~SelfMaskWorker() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  thread_.join();
+}
+
+bool SelfMaskWorker::offer(const sensor_msgs::ImageConstPtr& image, const core::Pose2D& pose,
+                           const core::ColorLut& lut) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (busy_ || job_ || stop_) return false;
+  if (last_taken_ && !core::SelfMaskLearner::isNewPose(*last_taken_, pose)) return false;
+  last_taken_ = pose;
+  job_ = Job{image, pose, lut};
+  wake_.notify_all();
+  return true;
+}
+
+int SelfMaskWorker::poses() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return poses_;
+}
+
+std::string SelfMaskWorker::lastError() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_error_;
+}
+
+double SelfMaskWorker::lastMs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_ms_;
+}
+
+core::CameraCalibration SelfMaskWorker::learned() const {
+  core::CameraCalibration camera = camera_;
+  camera.self_mask_file.clear();
+  std::lock_guard<std::mutex> lock(learner_mutex_);
+  camera.self_mask = learner_.mask();
+  return camera;
+}
+
+void SelfMaskWorker::run() {
+  for (;;) {
+    Job job;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [this] { return stop_ || job_; });
+      if (stop_) return;
+      job = std::move(*job_);
+      job_.reset();
+      busy_ = true;
+    }
+    const auto start = std::chrono::steady_clock::now();
+    std::string error;
+    int poses = 0;
+    core::ImageView view;
+    if (imageView(*job.image, &view, &error)) {
+      try {
+        std::lock_guard<std::mutex> lock(learner_mutex_);
+        learner_.add(view, job.pose, job.lut);
+        poses = learner_.frames();
+      } catch (const std::exception& e) {
+        error = e.what();
+      }
+    }
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    std::lock_guard<std::mutex> lock(mutex_);
+    busy_ = false;
+    last_ms_ = ms;
+    if (error.empty()) poses_ = poses;
+    last_error_ = error;
+  }
+}
+
+}  // namespace ros_conversions
+}  // namespace act_color

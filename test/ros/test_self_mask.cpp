@@ -1,0 +1,179 @@
+// The trainer nodelet learns the own robot's pixels while the robot drives (~learn_self_mask,
+// issue 12) and saves them with ~save_self_mask: a drive of 24 poses over family scene 40, as
+// act_eval --learn-self-mask drives it, gives a mask on the scene's mirror struts and nowhere else,
+// while every frame is trained and published as before. The service writes only inside ~lut_dir and
+// never over a file that is not a PNG; a trainer without ~learn_self_mask says so.
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <gtest/gtest.h>
+#include <nodelet/NodeletLoad.h>
+#include <ros/ros.h>
+#include <sys/stat.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "act_color/ColorLut.h"
+#include "act_color/FilePath.h"
+#include "act_color/core/calibration.hpp"
+#include "act_color/sim/family_evaluation.hpp"
+#include "act_color/sim/renderer.hpp"
+#include "act_color/sim/scene_family.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+namespace core = act_color::core;
+namespace sim = act_color::sim;
+
+bool load(const std::string& name) {
+  nodelet::NodeletLoad srv;
+  srv.request.name = name;
+  srv.request.type = "act_color/act_trainer";
+  return ros::service::call("/self_mask_manager/load_nodelet", srv) && srv.response.success;
+}
+
+act_color::FilePath::Response saveSelfMask(const std::string& trainer, const std::string& path) {
+  act_color::FilePath srv;
+  srv.request.path = path;
+  EXPECT_TRUE(ros::service::call(trainer + "/save_self_mask", srv)) << trainer << " did not answer";
+  return srv.response;
+}
+
+TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
+  ros::NodeHandle nh, pnh("~");
+  const std::string dir = pnh.param<std::string>("dir", "/tmp/act_color_self_mask_test");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/lut");
+  const sim::FamilyScene scene = sim::makeFamilyScene(40);
+  core::Calibration calibration = scene.calibration;
+  calibration.camera.self_mask.clear();
+  calibration.camera.self_mask_file.clear();
+  std::ofstream(dir + "/family_40.yaml") << core::toYaml(calibration);
+
+  for (const std::string name : {"/drive/trainer", "/still/trainer"}) {
+    nh.setParam(name + "/calibration", dir + "/family_40.yaml");
+    nh.setParam(name + "/lut_dir", dir + "/lut");
+    nh.setParam(name + "/bootstrap_at_first_pose", true);
+  }
+  nh.setParam("/drive/trainer/learn_self_mask", true);
+  ASSERT_TRUE(ros::service::waitForService("/self_mask_manager/load_nodelet", ros::Duration(30.0)));
+  ASSERT_TRUE(load("/drive/trainer"));
+  ASSERT_TRUE(load("/still/trainer"));
+
+  act_color_test::Waiter waiter;
+  size_t tables = 0;
+  ros::Subscriber lut_sub =
+      nh.subscribe<act_color::ColorLut>("/drive/color_lut", 100, [&](const act_color::ColorLutConstPtr&) {
+        std::lock_guard<std::mutex> lock(waiter.mutex());
+        ++tables;
+        waiter.notify();
+      });
+  // The trainer's diagnostics: the poses counted and the time one took.
+  std::map<std::string, std::string> diagnostics;
+  ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& m) {
+        std::lock_guard<std::mutex> lock(waiter.mutex());
+        for (const auto& status : m->status) {
+          if (status.name.find("drive/trainer") == std::string::npos) continue;
+          for (const auto& kv : status.values) diagnostics[kv.key] = kv.value;
+        }
+        waiter.notify();
+      });
+  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/drive/image", 10);
+  ros::Publisher pose_pub = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/drive/pose", 10);
+  ros::AsyncSpinner spinner(1);
+  spinner.start();
+  ASSERT_TRUE(waiter.waitFor(30.0, [&] {
+    return image_pub.getNumSubscribers() >= 1 && pose_pub.getNumSubscribers() >= 1 && lut_sub.getNumPublishers() >= 1;
+  })) << "the trainer did not connect";
+  // Not before the calibration is loaded (it is built off the manager's load path).
+  const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
+  std::string answer;
+  while (ros::WallTime::now() < until &&
+         (answer = saveSelfMask("/drive/trainer", "").message).find("still loading") != std::string::npos) {
+    ros::WallDuration(0.1).sleep();
+  }
+  EXPECT_NE(answer.find("no frame counted yet"), std::string::npos) << answer;
+
+  // The drive: each pose for kDriveCyclesPerPose frames at 20 Hz, the pose sent before its image.
+  const sim::Renderer renderer(calibration, scene.renderer);
+  sim::Scene drive = scene.scenario.frames.front().scene;
+  const std::vector<core::Pose2D> poses = sim::drivePoses(scene, sim::kDrivePoses);
+  ASSERT_EQ(poses.size(), static_cast<size_t>(sim::kDrivePoses));
+  size_t sent = 0;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    drive.robot_pose = poses[k];
+    drive.noise_seed = sim::kDriveNoiseSeed + static_cast<uint32_t>(k);
+    const sim::LabeledFrame frame = renderer.render(drive);
+    for (int c = 0; c < sim::kDriveCyclesPerPose; ++c) {
+      const ros::Time t = ros::Time::now();
+      pose_pub.publish(act_color_test::makePose(poses[k], t));
+      image_pub.publish(act_color_test::makeImage(frame.rgb, "rgb8", t));
+      ++sent;
+      ros::WallDuration(0.05).sleep();
+    }
+  }
+  // Every frame trained and its table published: learning holds nothing up.
+  EXPECT_TRUE(waiter.waitFor(10.0, [&] { return tables >= sent; })) << tables << " tables for " << sent << " frames";
+
+  const std::string poses_key = "self mask learned from (distinct poses)";
+  EXPECT_TRUE(waiter.waitFor(10.0, [&] { return diagnostics[poses_key] == "24"; })) << diagnostics[poses_key];
+  {
+    std::lock_guard<std::mutex> lock(waiter.mutex());
+    std::printf("diagnostics: %s %s, last pose counted in %s ms\n", poses_key.c_str(), diagnostics[poses_key].c_str(),
+                diagnostics["self mask: last pose counted in (ms, own thread)"].c_str());
+  }
+  const auto saved = saveSelfMask("/drive/trainer", "");
+  std::printf("~save_self_mask: %s\n", saved.message.c_str());
+  ASSERT_TRUE(saved.success) << saved.message;
+  EXPECT_NE(saved.message.find("from 24 distinct poses"), std::string::npos) << saved.message;
+  const cv::Mat mask = cv::imread(dir + "/lut/self_mask.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(mask.cols, calibration.camera.width);
+  ASSERT_EQ(mask.rows, calibration.camera.height);
+  const std::vector<uint8_t> struts = renderer.strutMask();
+  size_t on = 0, off = 0, strut_pixels = 0;
+  for (size_t i = 0; i < struts.size(); ++i) {
+    strut_pixels += struts[i];
+    (struts[i] ? on : off) += mask.data[i] != 0;
+  }
+  std::printf("learned online: %zu of the %zu strut pixels, %zu others\n", on, strut_pixels, off);
+  EXPECT_GT(on, 0.9 * strut_pixels);
+  EXPECT_LT(off, 0.01 * strut_pixels);
+  // The calibration takes it as it is (the PNG's size is the camera's).
+  calibration.camera.self_mask_file = dir + "/lut/self_mask.png";
+  std::ofstream(dir + "/masked.yaml") << core::toYaml(calibration);
+  EXPECT_NO_THROW(core::loadCalibration(dir + "/masked.yaml"));
+
+  // Only inside ~lut_dir, never over what is not a PNG, and only when learning.
+  const auto outside = saveSelfMask("/drive/trainer", "../outside.png");
+  EXPECT_FALSE(outside.success);
+  EXPECT_NE(outside.message.find("not inside ~lut_dir"), std::string::npos) << outside.message;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/outside.png"));
+  std::ofstream(dir + "/lut/notes.txt") << "a team's notes\n";
+  const auto over = saveSelfMask("/drive/trainer", "notes.txt");
+  EXPECT_FALSE(over.success);
+  EXPECT_NE(over.message.find("is not a PNG image: not overwritten"), std::string::npos) << over.message;
+  std::ifstream notes(dir + "/lut/notes.txt");
+  std::string line;
+  std::getline(notes, line);
+  EXPECT_EQ(line, "a team's notes");
+  const auto again = saveSelfMask("/drive/trainer", "self_mask.png");  // its own PNG: replaced
+  EXPECT_TRUE(again.success) << again.message;
+  const auto off_answer = saveSelfMask("/still/trainer", "");
+  EXPECT_FALSE(off_answer.success);
+  EXPECT_NE(off_answer.message.find("~learn_self_mask is off"), std::string::npos) << off_answer.message;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_self_mask");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
