@@ -6,6 +6,7 @@
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
 #include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
 #include <sys/stat.h>
 
@@ -37,6 +38,24 @@ bool load(const std::string& name) {
   return ros::service::call("/self_mask_manager/load_nodelet", srv) && srv.response.success;
 }
 
+bool unload(const std::string& name) {
+  nodelet::NodeletUnload srv;
+  srv.request.name = name;
+  return ros::service::call("/self_mask_manager/unload_nodelet", srv) && srv.response.success;
+}
+
+// Family scene 40 (three mirror struts) and its calibration without a self mask, written to
+// `dir`/family_40.yaml.
+sim::FamilyScene writeScene(const std::string& dir, core::Calibration* calibration) {
+  sim::FamilyScene scene = sim::makeFamilyScene(40);
+  *calibration = scene.calibration;
+  calibration->camera.self_mask.clear();
+  calibration->camera.self_mask_file.clear();
+  std::filesystem::create_directories(dir + "/lut");
+  std::ofstream(dir + "/family_40.yaml") << core::toYaml(*calibration);
+  return scene;
+}
+
 act_color::FilePath::Response saveSelfMask(const std::string& trainer, const std::string& path) {
   act_color::FilePath srv;
   srv.request.path = path;
@@ -48,12 +67,8 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   ros::NodeHandle nh, pnh("~");
   const std::string dir = pnh.param<std::string>("dir", "/tmp/act_color_self_mask_test");
   std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir + "/lut");
-  const sim::FamilyScene scene = sim::makeFamilyScene(40);
-  core::Calibration calibration = scene.calibration;
-  calibration.camera.self_mask.clear();
-  calibration.camera.self_mask_file.clear();
-  std::ofstream(dir + "/family_40.yaml") << core::toYaml(calibration);
+  core::Calibration calibration;
+  const sim::FamilyScene scene = writeScene(dir, &calibration);
 
   for (const std::string name : {"/drive/trainer", "/still/trainer"}) {
     nh.setParam(name + "/calibration", dir + "/family_40.yaml");
@@ -167,6 +182,48 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   const auto off_answer = saveSelfMask("/still/trainer", "");
   EXPECT_FALSE(off_answer.success);
   EXPECT_NE(off_answer.message.find("~learn_self_mask is off"), std::string::npos) << off_answer.message;
+}
+
+// The learner's thread goes with its nodelet: unloaded while frames at new poses keep coming (a
+// pose being counted, another offered), the manager runs on and loads the next one.
+TEST(SelfMask, UnloadingWhileLearningLeavesTheManagerRunning) {
+  ros::NodeHandle nh, pnh("~");
+  const std::string dir = pnh.param<std::string>("dir", "/tmp/act_color_self_mask_test") + "/cycles";
+  core::Calibration calibration;
+  const sim::FamilyScene scene = writeScene(dir, &calibration);
+  const sim::Renderer renderer(calibration, scene.renderer);
+  sim::Scene drive = scene.scenario.frames.front().scene;
+  const std::vector<core::Pose2D> poses = sim::drivePoses(scene, 8);
+  std::vector<cv::Mat> frames;
+  for (const core::Pose2D& pose : poses) {
+    drive.robot_pose = pose;
+    frames.push_back(renderer.render(drive).rgb);
+  }
+  ASSERT_TRUE(ros::service::waitForService("/self_mask_manager/load_nodelet", ros::Duration(30.0)));
+  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/cycle/image", 10);
+  ros::Publisher pose_pub = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("/cycle/pose", 10);
+  nh.setParam("/cycle/trainer/calibration", dir + "/family_40.yaml");
+  nh.setParam("/cycle/trainer/lut_dir", dir + "/lut");
+  nh.setParam("/cycle/trainer/bootstrap_at_first_pose", true);
+  nh.setParam("/cycle/trainer/learn_self_mask", true);
+  for (int round = 0; round < 5; ++round) {
+    ASSERT_TRUE(load("/cycle/trainer")) << "round " << round;
+    // Until it answers that it learns (its calibration loaded), then frames at every pose.
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
+    while (ros::WallTime::now() < until &&
+           saveSelfMask("/cycle/trainer", "").message.find("no frame counted yet") == std::string::npos) {
+      ros::WallDuration(0.05).sleep();
+    }
+    for (size_t k = 0; k < poses.size(); ++k) {
+      const ros::Time t = ros::Time::now();
+      pose_pub.publish(act_color_test::makePose(poses[k], t));
+      image_pub.publish(act_color_test::makeImage(frames[k], "rgb8", t));
+      ros::WallDuration(0.01).sleep();
+    }
+    ASSERT_TRUE(unload("/cycle/trainer")) << "round " << round;
+  }
+  EXPECT_TRUE(load("/cycle/trainer"));
+  EXPECT_TRUE(unload("/cycle/trainer"));
 }
 
 }  // namespace
