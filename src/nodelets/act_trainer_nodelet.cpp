@@ -1007,8 +1007,8 @@ bool ActTrainerNodelet::onSaveSelfMask(FilePath::Request& req, FilePath::Respons
     }
   }
   if (worker) {
-    const int poses = worker->poses();
-    const core::CameraCalibration camera = worker->learned();
+    int poses = 0;
+    const core::CameraCalibration camera = worker->learned(&poses);
     if (poses == 0) {
       res.message = "no frame counted yet: the self mask is learned from trained frames at distinct poses";
       const std::string error = worker->lastError();

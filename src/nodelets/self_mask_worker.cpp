@@ -44,11 +44,12 @@ double SelfMaskWorker::lastMs() const {
   return last_ms_;
 }
 
-core::CameraCalibration SelfMaskWorker::learned() const {
+core::CameraCalibration SelfMaskWorker::learned(int* poses) const {
   core::CameraCalibration camera = camera_;
   camera.self_mask_file.clear();
   std::lock_guard<std::mutex> lock(learner_mutex_);
   camera.self_mask = learner_.mask();
+  *poses = learner_.frames();
   return camera;
 }
 

@@ -35,9 +35,9 @@ class SelfMaskWorker {
   bool offer(const sensor_msgs::ImageConstPtr& image, const core::Pose2D& pose, const core::ColorLut& lut);
   // Distinct poses counted so far.
   int poses() const;
-  // The camera with the mask learned so far as its self mask (self_mask empty before any pose).
-  // Waits for a frame being counted.
-  core::CameraCalibration learned() const;
+  // The camera with the mask learned so far as its self mask (self_mask empty before any pose), and
+  // the distinct poses it was learned from. Waits for a frame being counted.
+  core::CameraCalibration learned(int* poses) const;
   // Why the last frame could not be counted ("" when it was).
   std::string lastError() const;
   // How long counting the last frame took (ms, on the worker's thread; 0 before any).
