@@ -29,6 +29,7 @@
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/feature_extractor.hpp"
 #include "act_color/core/segmenter.hpp"
+#include "act_color/core/self_mask_learner.hpp"
 #include "act_color/ros/conversions.hpp"
 #include "act_color/sim/renderer.hpp"
 #include "act_color/sim/scenario.hpp"
@@ -235,6 +236,25 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
     const Frame& f = frames[i++ % frames.size()];
     cycling_no_ball.cycle(view(f), f.pose);
   });
+  // The trainer nodelet's ~learn_self_mask: one pose counted by core::SelfMaskLearner (on the
+  // worker's thread, SelfMaskWorker) and the image callback's share of it, the table copied for
+  // the worker (once per new pose; every other frame costs one pose comparison).
+  {
+    core::SelfMaskLearner learner(cal);
+    int turn = 0;
+    add("self_mask_count_pose", [&] {
+      const Frame& f = frames[i++ % frames.size()];
+      Pose2D pose = f.pose;
+      pose.theta_rad += 0.35 * (++turn % 16);  // 20 degrees on: every call is a new pose, counted
+      learner.add(view(f), pose, trainer.lut());
+    });
+    volatile uint8_t sink = 0;
+    add("self_mask_table_copy", [&] {
+      const core::ColorLut copy = trainer.lut();
+      sink = copy.data()[i++ % copy.size()];
+    });
+    (void)sink;
+  }
   cv::Mat labels, labels_b;
   add("classify", [&] { segmenter.classify(trainer.lut(), view(frames[i++ % frames.size()]), labels); });
   add("classify_unmasked", [&] { unmasked.classify(trainer.lut(), view(frames[i++ % frames.size()]), labels); });
@@ -470,6 +490,13 @@ int main(int argc, char** argv) {
       out << "  (without the ball stage " << no_ball->median_ms << " ms: the stage takes " << std::setprecision(0)
           << 100.0 * (1.0 - no_ball->median_ms / cycle->median_ms) << "% of the cycle)\n"
           << std::setprecision(4);
+    }
+    if (const auto* pose = find(*r580, "self_mask_count_pose")) {
+      const auto* copy = find(*r580, "self_mask_table_copy");
+      out << "  (~learn_self_mask: a pose counted in " << pose->median_ms << " ms on its own thread, "
+          << std::setprecision(1) << pose->median_ms / cycle->median_ms
+          << " ACT cycles; the image callback copies the table, " << std::setprecision(4) << copy->median_ms
+          << " ms, once per new pose)\n";
     }
     out << "  classification " << std::setprecision(2) << cls->pixels_per_s() / 1e9
         << " Gpixel/s >= 1: " << (cls->pixels_per_s() >= 1e9 ? "met" : "MISSED") << "; "
