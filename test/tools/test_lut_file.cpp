@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <string>
 #include <vector>
@@ -205,6 +206,40 @@ TEST(LutFile, SavesStayInsideTheirFolderAndReplaceOnlyTables) {
   for (const char* name : {"/table.lut", "/notes.lut"}) entries += static_cast<bool>(std::ifstream(dir + name));
   EXPECT_EQ(entries, 2);
   EXPECT_EQ(std::system(("test $(ls " + dir + " | wc -l) -eq 3").c_str()), 0) << "temporary files left";
+}
+
+// The trainer's ~save_self_mask: the learned mask as a PNG (core::encodeSelfMask), written like a
+// table (conv::savePngFile): atomically, and over nothing but a PNG.
+TEST(LutFile, ASelfMaskReplacesOnlyAPng) {
+  const std::string dir = scratch() + "/masks";
+  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
+  core::CameraCalibration camera;
+  camera.width = 8;
+  camera.height = 6;
+  camera.self_mask.assign(48, 0);
+  camera.self_mask[9] = camera.self_mask[10] = camera.self_mask[47] = 1;
+  const std::vector<uint8_t> png = core::encodeSelfMask(camera);
+  std::string error;
+  const std::string path = dir + "/self_mask.png";
+  ASSERT_TRUE(conv::savePngFile(png, path, &error)) << error;
+  const cv::Mat back = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(back.cols, 8);
+  ASSERT_EQ(back.rows, 6);
+  for (int i = 0; i < 48; ++i) EXPECT_EQ(back.data[i] != 0, camera.self_mask[i] != 0) << "pixel " << i;
+  camera.self_mask[0] = 1;
+  ASSERT_TRUE(conv::savePngFile(core::encodeSelfMask(camera), path, &error)) << error;  // its own PNG: replaced
+  EXPECT_NE(cv::imread(path, cv::IMREAD_GRAYSCALE).data[0], 0);
+  const std::string notes = dir + "/notes.txt";
+  write(notes, std::vector<uint8_t>{'h', 'i', '\n'});
+  EXPECT_FALSE(conv::savePngFile(png, notes, &error));
+  EXPECT_NE(error.find("is not a PNG image: not overwritten"), std::string::npos) << error;
+  EXPECT_EQ(bytesOf(notes), (std::vector<uint8_t>{'h', 'i', '\n'}));
+  EXPECT_FALSE(conv::savePngFile(png, std::string("a\0b", 3), &error));
+  EXPECT_EQ(std::system(("test $(ls " + dir + " | wc -l) -eq 2").c_str()), 0) << "temporary files left";
+  // A mask of another size than the camera's is no mask of it.
+  camera.self_mask.pop_back();
+  EXPECT_THROW(core::encodeSelfMask(camera), core::CalibrationError);
+  EXPECT_THROW(core::saveSelfMask(camera, dir + "/other.png"), core::CalibrationError);
 }
 
 }  // namespace
