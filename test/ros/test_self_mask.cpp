@@ -107,6 +107,7 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
     return image_pub.getNumSubscribers() >= 1 && pose_pub.getNumSubscribers() >= 1 && lut_sub.getNumPublishers() >= 1;
   })) << "the trainer did not connect";
   // Not before the calibration is loaded (it is built off the manager's load path).
+  ASSERT_TRUE(ros::service::waitForService("/drive/trainer/save_self_mask", ros::Duration(30.0)));
   const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
   std::string answer;
   while (ros::WallTime::now() < until &&
@@ -208,12 +209,19 @@ TEST(SelfMask, UnloadingWhileLearningLeavesTheManagerRunning) {
   nh.setParam("/cycle/trainer/learn_self_mask", true);
   for (int round = 0; round < 5; ++round) {
     ASSERT_TRUE(load("/cycle/trainer")) << "round " << round;
-    // Until it answers that it learns (its calibration loaded), then frames at every pose.
-    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
-    while (ros::WallTime::now() < until &&
-           saveSelfMask("/cycle/trainer", "").message.find("no frame counted yet") == std::string::npos) {
-      ros::WallDuration(0.05).sleep();
+    // Until its calibration is loaded (it answers, and not "still loading"), then frames at every
+    // pose. (Under ASan it had sometimes counted poses already: frames of the round before, still on
+    // their way to the manager when the nodelet was unloaded and the next one subscribed.)
+    ASSERT_TRUE(ros::service::waitForService("/cycle/trainer/save_self_mask", ros::Duration(30.0)));
+    const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(60.0);
+    act_color::FilePath srv;
+    bool ready = false;
+    while (!ready && ros::WallTime::now() < until) {
+      ready = ros::service::call("/cycle/trainer/save_self_mask", srv) &&
+              srv.response.message.find("still loading") == std::string::npos;
+      if (!ready) ros::WallDuration(0.05).sleep();
     }
+    EXPECT_TRUE(ready) << "round " << round << ": " << srv.response.message;
     for (size_t k = 0; k < poses.size(); ++k) {
       const ros::Time t = ros::Time::now();
       pose_pub.publish(act_color_test::makePose(poses[k], t));
