@@ -1,5 +1,7 @@
 #include "act_color/ros/self_mask_worker.hpp"
 
+#include <chrono>
+
 #include "act_color/core/image_view.hpp"
 #include "act_color/ros/conversions.hpp"
 

@@ -2,7 +2,6 @@
 
 #include <sensor_msgs/Image.h>
 
-#include <chrono>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
