@@ -55,6 +55,8 @@ SelfMaskLearner::SelfMaskLearner(const Calibration& calibration)
   color_sum_sq_.assign(pixels, 0.0);
 }
 
+size_t SelfMaskLearner::headingsFaced() const { return std::bitset<kHeadingSectors>(heading_sectors_).count(); }
+
 bool SelfMaskLearner::isNewPose(const Pose2D& last, const Pose2D& pose) {
   const double moved = std::hypot(pose.x_m - last.x_m, pose.y_m - last.y_m);
   const double turned = std::abs(std::remainder(pose.theta_rad - last.theta_rad, 2 * M_PI));
@@ -191,7 +193,7 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
     // expected at that keep their color, narrow across it (a wall or ceiling of one color keeps
     // its color too, but all round). Only once the robot has faced kMinHeadingSectors directions:
     // driving straight on, a pole far to the side stays at its pixels too.
-    if (std::bitset<kHeadingSectors>(heading_sectors_).count() < kMinHeadingSectors) hall.setTo(0);
+    if (headingsFaced() < kMinHeadingSectors) hall.setTo(0);
     cv::Mat narrow(height, width, CV_8UC1, cv::Scalar(0));
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {

@@ -1008,7 +1008,8 @@ bool ActTrainerNodelet::onSaveSelfMask(FilePath::Request& req, FilePath::Respons
   }
   if (worker) {
     int poses = 0;
-    const core::CameraCalibration camera = worker->learned(&poses);
+    size_t headings = 0;
+    const core::CameraCalibration camera = worker->learned(&poses, &headings);
     if (poses == 0) {
       res.message = "no frame counted yet: the self mask is learned from trained frames at distinct poses";
       const std::string error = worker->lastError();
@@ -1036,9 +1037,13 @@ bool ActTrainerNodelet::onSaveSelfMask(FilePath::Request& req, FilePath::Respons
         m << "saved the self mask learned from " << poses << " distinct poses (" << pixels << " pixels, "
           << 100.0 * static_cast<double>(pixels) / static_cast<double>(camera.self_mask.size()) << "% of the image) to "
           << *shared_path << ": set 'self_mask: " << *shared_path << "' in the calibration's camera section";
+        m << "; the poses faced " << headings << " of " << core::SelfMaskLearner::kHeadingSectors << " directions";
         if (poses < core::SelfMaskLearner::kMinPosesForConstancy) {
           m << "; fewer than " << core::SelfMaskLearner::kMinPosesForConstancy
             << " distinct poses, so struts are not yet followed over the hall: drive and turn on, then save again";
+        } else if (headings < core::SelfMaskLearner::kMinHeadingSectors) {
+          m << "; fewer than " << core::SelfMaskLearner::kMinHeadingSectors
+            << ", so struts over the hall alone are not looked for yet: turn on, then save again";
         }
         res.message = m.str();
       }
@@ -1156,6 +1161,8 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("time jumps back", time_jumps_);
   if (self_mask_) {
     status.add("self mask learned from (distinct poses)", self_mask_->poses());
+    status.add("self mask: directions faced (of " + std::to_string(core::SelfMaskLearner::kHeadingSectors) + ")",
+               self_mask_->headings());
     status.add("self mask: last pose counted in (ms, own thread)", self_mask_->lastMs());
     const std::string error = self_mask_->lastError();
     if (!error.empty()) status.add("self mask: last frame not counted", error);

@@ -36,6 +36,11 @@ int SelfMaskWorker::poses() const {
   return poses_;
 }
 
+size_t SelfMaskWorker::headings() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return headings_;
+}
+
 std::string SelfMaskWorker::lastError() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return last_error_;
@@ -46,12 +51,13 @@ double SelfMaskWorker::lastMs() const {
   return last_ms_;
 }
 
-core::CameraCalibration SelfMaskWorker::learned(int* poses) const {
+core::CameraCalibration SelfMaskWorker::learned(int* poses, size_t* headings) const {
   core::CameraCalibration camera = camera_;
   camera.self_mask_file.clear();
   std::lock_guard<std::mutex> lock(learner_mutex_);
   camera.self_mask = learner_.mask();
   *poses = learner_.frames();
+  *headings = learner_.headingsFaced();
   return camera;
 }
 
@@ -69,12 +75,14 @@ void SelfMaskWorker::run() {
     const auto start = std::chrono::steady_clock::now();
     std::string error;
     int poses = 0;
+    size_t headings = 0;
     core::ImageView view;
     if (imageView(*job.image, &view, &error)) {
       try {
         std::lock_guard<std::mutex> lock(learner_mutex_);
         learner_.add(view, job.pose, job.lut);
         poses = learner_.frames();
+        headings = learner_.headingsFaced();
       } catch (const std::exception& e) {
         error = e.what();
       }
@@ -83,7 +91,10 @@ void SelfMaskWorker::run() {
     std::lock_guard<std::mutex> lock(mutex_);
     busy_ = false;
     last_ms_ = ms;
-    if (error.empty()) poses_ = poses;
+    if (error.empty()) {
+      poses_ = poses;
+      headings_ = headings;
+    }
     last_error_ = error;
   }
 }

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -21,6 +22,7 @@
 #include "act_color/ColorLut.h"
 #include "act_color/FilePath.h"
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/self_mask_learner.hpp"
 #include "act_color/sim/family_evaluation.hpp"
 #include "act_color/sim/renderer.hpp"
 #include "act_color/sim/scene_family.hpp"
@@ -148,6 +150,16 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   std::printf("~save_self_mask: %s\n", saved.message.c_str());
   ASSERT_TRUE(saved.success) << saved.message;
   EXPECT_NE(saved.message.find("from 24 distinct poses"), std::string::npos) << saved.message;
+  // A drive that turned: enough directions faced, nothing left to ask of the driver.
+  const size_t faced_at = saved.message.find("the poses faced ");
+  ASSERT_NE(faced_at, std::string::npos) << saved.message;
+  const int faced = std::atoi(saved.message.c_str() + faced_at + 16);
+  EXPECT_GE(faced, static_cast<int>(core::SelfMaskLearner::kMinHeadingSectors)) << saved.message;
+  {
+    std::lock_guard<std::mutex> lock(waiter.mutex());
+    EXPECT_EQ(diagnostics["self mask: directions faced (of 8)"], std::to_string(faced));
+  }
+  EXPECT_EQ(saved.message.find("fewer than"), std::string::npos) << saved.message;
   const cv::Mat mask = cv::imread(dir + "/lut/self_mask.png", cv::IMREAD_GRAYSCALE);
   ASSERT_EQ(mask.cols, calibration.camera.width);
   ASSERT_EQ(mask.rows, calibration.camera.height);

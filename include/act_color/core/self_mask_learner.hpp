@@ -37,6 +37,8 @@ class SelfMaskLearner {
 
   // Frames counted so far (distinct poses).
   int frames() const { return frames_; }
+  // Of the kHeadingSectors directions, how many the poses counted so far faced.
+  size_t headingsFaced() const;
   // Whether add() counts a frame at `pose` after one counted at `last`: it moved kMinMoveM or
   // turned kMinTurnRad (a caller can tell before it copies a frame and its table for add()).
   static bool isNewPose(const Pose2D& last, const Pose2D& pose);
