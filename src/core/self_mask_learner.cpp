@@ -44,6 +44,16 @@ double runThrough(const cv::Mat& set, int u, int v, double ex, double ey, double
   return length;
 }
 
+// The distance of (u, v) from the mirror centre and the unit vector along its ray, (ex, ey) (0, 0
+// at the centre).
+double radial(const CameraCalibration& cal, int u, int v, double* ex, double* ey) {
+  const double du = u - cal.center_u, dv = v - cal.center_v;
+  const double r = std::hypot(du, dv);
+  *ex = r > 0 ? du / r : 0.0;
+  *ey = r > 0 ? dv / r : 0.0;
+  return r;
+}
+
 }  // namespace
 
 SelfMaskLearner::SelfMaskLearner(const Calibration& calibration)
@@ -136,12 +146,12 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
       if (!candidates.at<uint8_t>(v, u)) continue;
-      const double du = u - cal.center_u, dv = v - cal.center_v;
-      const double r = std::hypot(du, dv);
+      double ex, ey;
+      const double r = radial(cal, u, v, &ex, &ey);
       bool own = r <= chassis_ring;
       if (!own && r > 0) {
         // The run of candidates through this pixel along its ray.
-        own = runThrough(candidates, u, v, du / r, dv / r, min_run) >= min_run;
+        own = runThrough(candidates, u, v, ex, ey, min_run) >= min_run;
       }
       if (own) mask.at<uint8_t>(v, u) = 255;
     }
@@ -198,29 +208,27 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
         if (!hall.at<uint8_t>(v, u)) continue;
-        const double du = u - cal.center_u, dv = v - cal.center_v;
-        const double r = std::hypot(du, dv);
+        double ex, ey;
+        const double r = radial(cal, u, v, &ex, &ey);
         if (r <= 0) continue;
-        const double max_across = kMaxAcrossFraction * r;
-        if (runThrough(hall, u, v, -dv / r, du / r, max_across) <= max_across) narrow.at<uint8_t>(v, u) = 1;
+        const double max_across = kMaxAcrossFraction * r;  // across the ray: (-ey, ex)
+        if (runThrough(hall, u, v, -ey, ex, max_across) <= max_across) narrow.at<uint8_t>(v, u) = 1;
       }
     }
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
         if (!narrow.at<uint8_t>(v, u)) continue;
-        const double du = u - cal.center_u, dv = v - cal.center_v;
-        const double r = std::hypot(du, dv);
-        if (runThrough(narrow, u, v, du / r, dv / r, min_run) >= min_run) mask.at<uint8_t>(v, u) = 255;
+        double ex, ey;
+        radial(cal, u, v, &ex, &ey);
+        if (runThrough(narrow, u, v, ex, ey, min_run) >= min_run) mask.at<uint8_t>(v, u) = 255;
       }
     }
     const cv::Mat seeds = mask.clone();
     for (int v = 0; v < height; ++v) {
       for (int u = 0; u < width; ++u) {
         if (!seeds.at<uint8_t>(v, u)) continue;
-        const double du = u - cal.center_u, dv = v - cal.center_v;
-        const double r = std::hypot(du, dv);
-        if (r <= 0) continue;
-        const double ex = du / r, ey = dv / r;
+        double ex, ey;
+        if (radial(cal, u, v, &ex, &ey) <= 0) continue;
         for (const double dir : {1.0, -1.0}) {
           for (double s = 1;; ++s) {
             const int gu = static_cast<int>(std::lround(u + dir * s * ex)),

@@ -1012,7 +1012,7 @@ bool ActTrainerNodelet::onSaveSelfMask(FilePath::Request& req, FilePath::Respons
     const core::CameraCalibration camera = worker->learned(&poses, &headings);
     if (poses == 0) {
       res.message = "no frame counted yet: the self mask is learned from trained frames at distinct poses";
-      const std::string error = worker->lastError();
+      const std::string error = worker->progress().last_error;
       if (!error.empty()) res.message += " (the last one failed: " + error + ")";
     } else {
       const std::string requested = req.path.empty() ? "self_mask.png" : req.path;
@@ -1160,12 +1160,12 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("poses rejected", pose_source_.rejected());
   status.add("time jumps back", time_jumps_);
   if (self_mask_) {
-    status.add("self mask learned from (distinct poses)", self_mask_->poses());
+    const ros_conversions::SelfMaskWorker::Progress p = self_mask_->progress();
+    status.add("self mask learned from (distinct poses)", p.poses);
     status.add("self mask: directions faced (of " + std::to_string(core::SelfMaskLearner::kHeadingSectors) + ")",
-               self_mask_->headings());
-    status.add("self mask: last pose counted in (ms, own thread)", self_mask_->lastMs());
-    const std::string error = self_mask_->lastError();
-    if (!error.empty()) status.add("self mask: last frame not counted", error);
+               p.headings);
+    status.add("self mask: last pose counted in (ms, own thread)", p.last_ms);
+    if (!p.last_error.empty()) status.add("self mask: last frame not counted", p.last_error);
   }
   status.add("table revision", trainer_->revision());
   status.add("table fill (%)", fill_percent);

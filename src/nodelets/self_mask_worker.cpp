@@ -23,7 +23,7 @@ SelfMaskWorker::~SelfMaskWorker() {
 bool SelfMaskWorker::offer(const sensor_msgs::ImageConstPtr& image, const core::Pose2D& pose,
                            const core::ColorLut& lut) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (busy_ || job_ || stop_) return false;
+  if (busy_ || job_) return false;
   if (last_taken_ && !core::SelfMaskLearner::isNewPose(*last_taken_, pose)) return false;
   last_taken_ = pose;
   job_ = Job{image, pose, lut};
@@ -31,24 +31,9 @@ bool SelfMaskWorker::offer(const sensor_msgs::ImageConstPtr& image, const core::
   return true;
 }
 
-int SelfMaskWorker::poses() const {
+SelfMaskWorker::Progress SelfMaskWorker::progress() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return poses_;
-}
-
-size_t SelfMaskWorker::headings() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return headings_;
-}
-
-std::string SelfMaskWorker::lastError() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return last_error_;
-}
-
-double SelfMaskWorker::lastMs() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return last_ms_;
+  return progress_;
 }
 
 core::CameraCalibration SelfMaskWorker::learned(int* poses, size_t* headings) const {
@@ -90,12 +75,12 @@ void SelfMaskWorker::run() {
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     std::lock_guard<std::mutex> lock(mutex_);
     busy_ = false;
-    last_ms_ = ms;
+    progress_.last_ms = ms;
+    progress_.last_error = error;
     if (error.empty()) {
-      poses_ = poses;
-      headings_ = headings;
+      progress_.poses = poses;
+      progress_.headings = headings;
     }
-    last_error_ = error;
   }
 }
 

@@ -5,8 +5,6 @@
 // only have returned once the trainer was ready). Unloading nodelets while they load must leave
 // the manager running.
 #include <gtest/gtest.h>
-#include <nodelet/NodeletLoad.h>
-#include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
 
@@ -19,21 +17,15 @@
 #include <vector>
 
 #include "act_color/FilePath.h"
+#include "test_util.hpp"
 
 namespace {
 
 bool load(const std::string& name, const std::string& type) {
-  nodelet::NodeletLoad srv;
-  srv.request.name = name;
-  srv.request.type = type;
-  return ros::service::call("/load_manager/load_nodelet", srv) && srv.response.success;
+  return act_color_test::loadNodelet("/load_manager", name, type);
 }
 
-bool unload(const std::string& name) {
-  nodelet::NodeletUnload srv;
-  srv.request.name = name;
-  return ros::service::call("/load_manager/unload_nodelet", srv) && srv.response.success;
-}
+bool unload(const std::string& name) { return act_color_test::unloadNodelet("/load_manager", name); }
 
 // The trainer's answer to ~save_lut, or "" when the service did not answer.
 std::string saveAnswer(const std::string& trainer) {

@@ -5,8 +5,6 @@
 // never over a file that is not a PNG; a trainer without ~learn_self_mask says so.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <gtest/gtest.h>
-#include <nodelet/NodeletLoad.h>
-#include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
 #include <sys/stat.h>
 
@@ -34,17 +32,10 @@ namespace core = act_color::core;
 namespace sim = act_color::sim;
 
 bool load(const std::string& name) {
-  nodelet::NodeletLoad srv;
-  srv.request.name = name;
-  srv.request.type = "act_color/act_trainer";
-  return ros::service::call("/self_mask_manager/load_nodelet", srv) && srv.response.success;
+  return act_color_test::loadNodelet("/self_mask_manager", name, "act_color/act_trainer");
 }
 
-bool unload(const std::string& name) {
-  nodelet::NodeletUnload srv;
-  srv.request.name = name;
-  return ros::service::call("/self_mask_manager/unload_nodelet", srv) && srv.response.success;
-}
+bool unload(const std::string& name) { return act_color_test::unloadNodelet("/self_mask_manager", name); }
 
 // Family scene 40 (three mirror struts) and its calibration without a self mask, written to
 // `dir`/family_40.yaml.

@@ -2,6 +2,8 @@
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
+#include <nodelet/NodeletLoad.h>
+#include <nodelet/NodeletUnload.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 
@@ -83,6 +85,22 @@ inline geometry_msgs::PoseWithCovarianceStamped makePose(const act_color::core::
   msg.pose.pose.orientation.z = std::sin(p.theta_rad / 2);
   msg.pose.pose.orientation.w = std::cos(p.theta_rad / 2);
   return msg;
+}
+
+// A nodelet of `type` loaded as `name` into the nodelet manager `manager` (its node name) through
+// the manager's service, as `rosrun nodelet nodelet load` does; false when the call or the load fails.
+inline bool loadNodelet(const std::string& manager, const std::string& name, const std::string& type) {
+  nodelet::NodeletLoad srv;
+  srv.request.name = name;
+  srv.request.type = type;
+  return ros::service::call(manager + "/load_nodelet", srv) && srv.response.success;
+}
+
+// The nodelet `name` unloaded from `manager`; false when the call or the unload fails.
+inline bool unloadNodelet(const std::string& manager, const std::string& name) {
+  nodelet::NodeletUnload srv;
+  srv.request.name = name;
+  return ros::service::call(manager + "/unload_nodelet", srv) && srv.response.success;
 }
 
 }  // namespace act_color_test

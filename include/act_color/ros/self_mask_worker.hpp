@@ -32,18 +32,19 @@ class SelfMaskWorker {
 
   // True when the frame was taken. The image message is kept (not copied) until it is counted.
   bool offer(const sensor_msgs::ImageConstPtr& image, const core::Pose2D& pose, const core::ColorLut& lut);
-  // Distinct poses counted so far, and the directions they faced (of
-  // SelfMaskLearner::kHeadingSectors).
-  int poses() const;
-  size_t headings() const;
+  // For the diagnostics, without waiting for a frame being counted: the learner's counts as of the
+  // last frame counted.
+  struct Progress {
+    int poses = 0;           // distinct poses counted
+    size_t headings = 0;     // directions they faced, of SelfMaskLearner::kHeadingSectors
+    double last_ms = 0.0;    // how long counting the last frame took (on the worker's thread)
+    std::string last_error;  // why the last frame could not be counted ("" when it was)
+  };
+  Progress progress() const;
   // The camera with the mask learned so far as its self mask (self_mask empty before any pose), the
   // distinct poses it was learned from and the directions they faced (of
   // SelfMaskLearner::kHeadingSectors). Waits for a frame being counted.
   core::CameraCalibration learned(int* poses, size_t* headings) const;
-  // Why the last frame could not be counted ("" when it was).
-  std::string lastError() const;
-  // How long counting the last frame took (ms, on the worker's thread; 0 before any).
-  double lastMs() const;
 
  private:
   struct Job {
@@ -63,10 +64,7 @@ class SelfMaskWorker {
   std::optional<Job> job_;
   bool busy_ = false, stop_ = false;
   std::optional<core::Pose2D> last_taken_;
-  int poses_ = 0;
-  size_t headings_ = 0;
-  double last_ms_ = 0.0;
-  std::string last_error_;
+  Progress progress_;
   std::thread thread_;  // last: starts once everything above is built
 };
 
