@@ -17,6 +17,7 @@ ACT_DEB_PACKAGES=(
   ros-std-msgs ros-geometry-msgs ros-message-generation ros-message-runtime python3-gencpp
   python3-genmsg python3-genpy librostest-dev python3-rostest python3-roslaunch python3-rosmaster
   rosout python3-rosbag librosbag-dev python3-rostopic python3-rosnode python3-rosparam
+  python3-rosservice
   rospack-tools libopencv-dev libeigen3-dev libgtest-dev rosbash python3-rosmsg
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libdiagnostic-updater-dev ros-diagnostic-msgs libbenchmark-dev libvisualization-msgs-dev ros-visualization-msgs catkin-lint
