@@ -303,6 +303,12 @@ ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
       rng_(params.seed),
       ball_detector_(model_, 0.5 * params.ball_diameter_m) {
   params_.validate();
+  findChassisPixels();
+  reset(ColorSpace::kRgb);
+  space_known_ = false;
+}
+
+void ActTrainer::findChassisPixels() {
   // The chassis is small in the image (a few dozen of the cluster step's samples at most): the
   // light model reads it densely, every n-th of its pixels.
   std::vector<uint32_t> chassis;
@@ -310,9 +316,21 @@ ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
     if (model_.camera().ray(i).region == PixelRegion::kChassis) chassis.push_back(static_cast<uint32_t>(i));
   }
   const size_t step = std::max<size_t>(1, chassis.size() / kChassisAnchorSamples);
+  chassis_pixels_.clear();
   for (size_t j = step / 2; j < chassis.size(); j += step) chassis_pixels_.push_back(chassis[j]);
-  reset(ColorSpace::kRgb);
-  space_known_ = false;
+}
+
+void ActTrainer::replaceModel(ExpectedClassModel model) {
+  if (model.camera().width() != model_.camera().width() || model.camera().height() != model_.camera().height()) {
+    throw std::invalid_argument("a camera model of " + std::to_string(model.camera().width()) + "x" +
+                                std::to_string(model.camera().height()) + " px for a trainer of " +
+                                std::to_string(model_.camera().width()) + "x" +
+                                std::to_string(model_.camera().height()));
+  }
+  model_ = std::move(model);
+  findChassisPixels();
+  removal_samples_.clear();  // its samples leave out the pixels that are never off the field
+  ball_detector_ = BallDetector(model_, 0.5 * params_.ball_diameter_m);
 }
 
 void ActTrainer::reset(ColorSpace space) {

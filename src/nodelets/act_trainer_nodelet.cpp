@@ -78,6 +78,9 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   void drain();
   // False: the image waits for its pose (may_wait and the pose may still come).
   bool trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_wait);
+  // ~learn_self_mask: the mask the worker learned, once it is new, used from this image on (the
+  // trainer's camera model, /act/classified) and published (latched) for the segmentation.
+  void useLearnedSelfMask(const std_msgs::Header& header);
   // `trained`: this image's cycle, when it trained (its ball is labelled in /act/classified).
   void publishOutputs(const core::ImageView& view, const sensor_msgs::ImageConstPtr& msg, bool have_pose,
                       const core::Pose2D& pose, const core::CycleStats* trained);
@@ -119,7 +122,8 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::Subscriber image_sub_;
   image_transport::Publisher classified_pub_, expected_pub_;
-  ros::Publisher lut_pub_, lut_throttled_pub_, debug_pub_, ball_pub_, pose_pub_, table_image_pub_, field_pub_;
+  ros::Publisher lut_pub_, lut_throttled_pub_, debug_pub_, ball_pub_, pose_pub_, table_image_pub_, field_pub_,
+      self_mask_pub_;
   std::string base_frame_, field_frame_;
   // The services' file I/O runs on a queue and thread of its own: a slow or stuck file system never
   // holds up training (the image callbacks' queue). The queue is declared before the servers on
@@ -153,6 +157,9 @@ class ActTrainerNodelet : public nodelet::Nodelet {
   bool learn_self_mask_ = false;
   // ~learn_self_mask: made with the trainer (loadCalibration), fed by trainOn.
   std::shared_ptr<ros_conversions::SelfMaskWorker> self_mask_;
+  int self_masks_used_ = 0;      // masks the worker handed over (useLearnedSelfMask)
+  size_t self_mask_pixels_ = 0;  // in the one in use
+  int self_mask_poses_ = 0;      // the distinct poses it was learned from
   bool reset_on_time_jump_ = false;
   bool debug_addresses_ = false;
   double max_pose_age_s_ = 1.0;
@@ -371,6 +378,8 @@ bool ActTrainerNodelet::configure(std::string* error) {
   // For people: the table as slices of its color cube (latched, at most once a second) and the
   // field model in the 3-D view.
   table_image_pub_ = nh_.advertise<sensor_msgs::Image>("table_image", 1, true);
+  // ~learn_self_mask: the own robot's pixels in use (mono8, 255 = own robot), for the segmentation.
+  self_mask_pub_ = nh_.advertise<sensor_msgs::Image>("self_mask", 1, true);
   table_image_timer_ = nh_.createWallTimer(ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) {
     try {
       publishTableImage();
@@ -606,6 +615,31 @@ void ActTrainerNodelet::onTimeJump(const ros::Time& from, const ros::Time& to) {
   }
 }
 
+void ActTrainerNodelet::useLearnedSelfMask(const std_msgs::Header& header) {
+  std::unique_ptr<ros_conversions::SelfMaskWorker::LearnedModel> learned = self_mask_->takeLearnedModel();
+  if (!learned) return;
+  const auto start = std::chrono::steady_clock::now();
+  trainer_->replaceModel(std::move(learned->model));
+  segmenter_ = std::make_unique<core::Segmenter>(learned->camera);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  ++self_masks_used_;
+  self_mask_pixels_ = learned->pixels;
+  self_mask_poses_ = learned->poses;
+  auto mask = boost::make_shared<sensor_msgs::Image>();
+  mask->header = header;
+  mask->encoding = "mono8";
+  mask->width = static_cast<uint32_t>(learned->camera.width);
+  mask->height = static_cast<uint32_t>(learned->camera.height);
+  mask->step = mask->width;
+  mask->data.resize(learned->camera.self_mask.size());
+  for (size_t i = 0; i < mask->data.size(); ++i) mask->data[i] = learned->camera.self_mask[i] ? 255 : 0;
+  self_mask_pub_.publish(mask);
+  NODELET_INFO(
+      "the own robot's pixels learned from %d distinct poses (%zu px) are used from the image stamped %.3f on "
+      "(taken over in %.1f ms; ~save_self_mask saves them for the calibration)",
+      learned->poses, learned->pixels, header.stamp.toSec(), ms);
+}
+
 void ActTrainerNodelet::record(Outcome outcome, double cycle_ms, double latency_ms) {
   const ros::WallTime now = ros::WallTime::now();
   window_.add({now, outcome, cycle_ms, latency_ms});
@@ -661,6 +695,7 @@ bool ActTrainerNodelet::trainOn(const sensor_msgs::ImageConstPtr& msg, bool may_
                  at.y_m, at.theta_rad);
     outcome = Outcome::kStartup;
   } else if (have_pose) {
+    if (self_mask_) useLearnedSelfMask(msg->header);
     last_stats_ = trainer_->cycle(view, pose);
     outcome = last_stats_.pose_contradicted ? Outcome::kContradicted : Outcome::kTrained;
     // The table after this frame's cycle classifies the frame for the self mask (as act_replay's).
@@ -1166,6 +1201,9 @@ void ActTrainerNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& st
                p.headings);
     status.add("self mask: last pose counted in (ms, own thread)", p.last_ms);
     if (!p.last_error.empty()) status.add("self mask: last frame not counted", p.last_error);
+    status.add("self mask in use (pixels)", self_mask_pixels_);
+    status.add("self mask in use: learned from (distinct poses)", self_mask_poses_);
+    status.add("self masks used so far", self_masks_used_);
   }
   status.add("table revision", trainer_->revision());
   status.add("table fill (%)", fill_percent);

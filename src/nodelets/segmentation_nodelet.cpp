@@ -69,6 +69,12 @@ class SegmentationNodelet : public nodelet::Nodelet {
   void onImage(const sensor_msgs::ImageConstPtr& msg);
   void onTable(const act_color::ColorLutConstPtr& msg);
   void onBall(const geometry_msgs::PointStampedConstPtr& msg);
+  // The own robot's pixels the trainer learned while the robot drives (its ~learn_self_mask;
+  // mono8 of the camera's size, nonzero = own robot), labelled black from then on as the
+  // calibration's self mask is. Kept until the calibration is loaded when it comes before.
+  void onSelfMask(const sensor_msgs::ImageConstPtr& msg);
+  // With the lock held: a segmenter with that mask; false (and why) when it does not fit the camera.
+  bool useSelfMask(const sensor_msgs::Image& msg, std::string* error);
   void flush();
   // The classify time in ms. `ball`: the trainer's sighting in this image, labelled as the ball's
   // image (core::labelBallImage).
@@ -82,7 +88,7 @@ class SegmentationNodelet : public nodelet::Nodelet {
   ros::NodeHandle nh_, pnh_;
   std::unique_ptr<image_transport::ImageTransport> it_;
   image_transport::Subscriber image_sub_;
-  ros::Subscriber lut_sub_, ball_sub_;
+  ros::Subscriber lut_sub_, ball_sub_, self_mask_sub_;
   image_transport::Publisher labels_pub_, labels_color_pub_;
   ros::Publisher features_pub_, debug_pub_;
   ros::WallTimer flush_timer_;
@@ -94,7 +100,11 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::mutex mutex_;  // guards everything below
   std::string config_error_;
   std::unique_ptr<core::OmniCameraModel> camera_;
-  std::unique_ptr<core::Segmenter> segmenter_;
+  // Replaced (not changed) when a learned self mask comes: process() classifies with its own copy.
+  std::shared_ptr<const core::Segmenter> segmenter_;
+  core::CameraCalibration camera_calibration_;    // the calibration's, for a learned self mask
+  sensor_msgs::ImageConstPtr pending_self_mask_;  // came while the calibration was loading
+  size_t self_mask_pixels_ = 0;                   // of the learned self mask in use
   // No segmenter yet and no error: the calibration is being loaded (segmenter_, camera_ and field_
   // follow).
   bool loading() const { return !segmenter_ && config_error_.empty(); }
@@ -173,6 +183,8 @@ bool SegmentationNodelet::configure(std::string* error) {
   // The labels in the classes' palette, for rviz; only computed while someone listens.
   labels_color_pub_ = it_->advertise("labels_color", 1, it_cb, it_cb);
   features_pub_ = nh_.advertise<act_color::VisionFeatures>("features", 2, cb, cb);
+  // Latched and rare: subscribed whether or not someone listens to the labels.
+  self_mask_sub_ = nh_.subscribe("self_mask", 1, &SegmentationNodelet::onSelfMask, this);
   reconfigure_ = std::make_unique<ros_conversions::CheckedReconfigure<SegmentationConfig>>(
       pnh_, c, [this](const SegmentationConfig& config, std::string* e) { return applyConfig(config, e); },
       [this](const std::string& e) {
@@ -195,7 +207,7 @@ void SegmentationNodelet::loadCalibration() {
   std::string calibration_path;
   const core::Calibration calibration = ros_conversions::loadCalibrationParam(pnh_, &pose_source_, &calibration_path);
   auto camera = std::make_unique<core::OmniCameraModel>(calibration.camera);
-  auto segmenter = std::make_unique<core::Segmenter>(calibration.camera);
+  auto segmenter = std::make_shared<const core::Segmenter>(calibration.camera);
   bool lazy = false;
   {
     // Set once: images are queued only while segmenter_ is set, so the processing outside the lock
@@ -203,8 +215,14 @@ void SegmentationNodelet::loadCalibration() {
     std::lock_guard<std::mutex> lock(mutex_);
     camera_ = std::move(camera);
     segmenter_ = std::move(segmenter);
+    camera_calibration_ = calibration.camera;
     field_ = calibration.field;
     lazy = lazy_;
+    std::string error;
+    if (pending_self_mask_ && !useSelfMask(*pending_self_mask_, &error)) {
+      NODELET_ERROR("the trainer's self mask is not used: %s", error.c_str());
+    }
+    pending_self_mask_.reset();
   }
   NODELET_INFO("segmentation ready: calibration %s, %s", calibration_path.c_str(),
                lazy ? "inputs subscribed while someone listens" : "always subscribed");
@@ -317,6 +335,49 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
   } catch (const std::exception& e) {
     ACT_WALL_THROTTLE(5.0, NODELET_ERROR("image stamped %.3f: %s", msg->header.stamp.toSec(), e.what()));
   }
+}
+
+void SegmentationNodelet::onSelfMask(const sensor_msgs::ImageConstPtr& msg) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!segmenter_) {
+    if (loading()) pending_self_mask_ = msg;
+    return;
+  }
+  std::string error;
+  if (useSelfMask(*msg, &error)) {
+    NODELET_INFO("the own robot's pixels learned by the trainer (%zu px) are labelled black from now on",
+                 self_mask_pixels_);
+  } else {
+    ACT_WALL_THROTTLE(5.0, NODELET_ERROR("the trainer's self mask is not used: %s", error.c_str()));
+  }
+}
+
+bool SegmentationNodelet::useSelfMask(const sensor_msgs::Image& msg, std::string* error) {
+  core::CameraCalibration camera = camera_calibration_;
+  if (msg.encoding != "mono8") {
+    *error = "encoding '" + msg.encoding + "', not mono8";
+    return false;
+  }
+  *error =
+      core::imageSizeProblem(static_cast<int>(msg.width), static_cast<int>(msg.height), camera.width, camera.height);
+  if (!error->empty()) return false;
+  if (msg.step < msg.width || msg.data.size() < static_cast<size_t>(msg.step) * msg.height) {
+    *error = "its data is shorter than its step and height say";
+    return false;
+  }
+  camera.self_mask.assign(static_cast<size_t>(msg.width) * msg.height, 0);
+  size_t pixels = 0;
+  for (uint32_t v = 0; v < msg.height; ++v) {
+    for (uint32_t u = 0; u < msg.width; ++u) {
+      const bool own = msg.data[static_cast<size_t>(v) * msg.step + u] != 0;
+      camera.self_mask[static_cast<size_t>(v) * msg.width + u] = own;
+      pixels += own;
+    }
+  }
+  camera.self_mask_file.clear();
+  segmenter_ = std::make_shared<const core::Segmenter>(camera);
+  self_mask_pixels_ = pixels;
+  return true;
 }
 
 void SegmentationNodelet::onTable(const act_color::ColorLutConstPtr& msg) {
@@ -445,9 +506,14 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
   // Labels written straight into the outgoing message.
   cv::Mat labels;
   sensor_msgs::ImagePtr labels_msg = ros_conversions::newLabelsMsg(*image, &labels);
+  std::shared_ptr<const core::Segmenter> segmenter;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    segmenter = segmenter_;
+  }
   const auto start = std::chrono::steady_clock::now();
   if (lut) {
-    segmenter_->classify(ros_conversions::lutView(*lut), view, labels);  // throws for a wrong size or color space
+    segmenter->classify(ros_conversions::lutView(*lut), view, labels);  // throws for a wrong size or color space
     if (ball) {
       double radius_m = 0;
       {
@@ -569,6 +635,7 @@ void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
     }
   }
   status.add("label rate (Hz)", window_.rateHz());
+  status.add("own robot's pixels learned by the trainer, labelled black", self_mask_pixels_);
   status.add("with the table of the same frame (%, last 5 s)", percent(exact, n));
   status.add("with an older or the newest table (%, last 5 s)", percent(stale, n));
   status.add("without a table, all unknown (%, last 5 s)", percent(none, n));

@@ -9,7 +9,7 @@ namespace act_color {
 namespace ros_conversions {
 
 SelfMaskWorker::SelfMaskWorker(const core::Calibration& calibration)
-    : camera_(calibration.camera), learner_(calibration), thread_([this] { run(); }) {}
+    : calibration_(calibration), learner_(calibration), thread_([this] { run(); }) {}
 
 SelfMaskWorker::~SelfMaskWorker() {
   {
@@ -37,13 +37,46 @@ SelfMaskWorker::Progress SelfMaskWorker::progress() const {
 }
 
 core::CameraCalibration SelfMaskWorker::learned(int* poses, size_t* headings) const {
-  core::CameraCalibration camera = camera_;
+  core::CameraCalibration camera = calibration_.camera;
   camera.self_mask_file.clear();
   std::lock_guard<std::mutex> lock(learner_mutex_);
   camera.self_mask = learner_.mask();
   *poses = learner_.frames();
   *headings = learner_.headingsFaced();
   return camera;
+}
+
+std::unique_ptr<SelfMaskWorker::LearnedModel> SelfMaskWorker::takeLearnedModel() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return std::move(learned_model_);
+}
+
+std::unique_ptr<SelfMaskWorker::LearnedModel> SelfMaskWorker::buildModelIfChanged(int poses) {
+  if (poses < core::SelfMaskLearner::kMinPosesForConstancy) return nullptr;
+  const std::vector<uint8_t> mask = learner_.mask();
+  if (handed_over_.size() != mask.size()) handed_over_.assign(mask.size(), 0);
+  size_t changed = 0, pixels = 0;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    changed += (mask[i] != 0) != (handed_over_[i] != 0);
+    pixels += mask[i] != 0;
+  }
+  if (pixels == 0 || static_cast<double>(changed) <= kApplyChangedFraction * static_cast<double>(mask.size())) {
+    return nullptr;
+  }
+  // The calibration's own mask (a team's edits) stays part of it.
+  core::Calibration calibration = calibration_;
+  std::vector<uint8_t>& in_use = calibration.camera.self_mask;
+  if (in_use.size() != mask.size()) in_use.assign(mask.size(), 0);
+  pixels = 0;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    in_use[i] = in_use[i] || mask[i];
+    pixels += in_use[i];
+  }
+  calibration.camera.self_mask_file.clear();
+  auto learned = std::unique_ptr<LearnedModel>(
+      new LearnedModel{core::ExpectedClassModel(calibration), calibration.camera, poses, pixels});
+  handed_over_ = mask;
+  return learned;
 }
 
 void SelfMaskWorker::run() {
@@ -61,6 +94,7 @@ void SelfMaskWorker::run() {
     std::string error;
     int poses = 0;
     size_t headings = 0;
+    std::unique_ptr<LearnedModel> learned;
     core::ImageView view;
     if (imageView(*job.image, &view, &error)) {
       try {
@@ -68,6 +102,7 @@ void SelfMaskWorker::run() {
         learner_.add(view, job.pose, job.lut);
         poses = learner_.frames();
         headings = learner_.headingsFaced();
+        learned = buildModelIfChanged(poses);
       } catch (const std::exception& e) {
         error = e.what();
       }
@@ -81,6 +116,7 @@ void SelfMaskWorker::run() {
       progress_.poses = poses;
       progress_.headings = headings;
     }
+    if (learned) learned_model_ = std::move(learned);  // a model not yet taken gives way to the newer one
   }
 }
 

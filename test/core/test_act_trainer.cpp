@@ -610,6 +610,47 @@ TEST_F(ActTrainerTest, TheTableDoesNotDependOnTheImageLayout) {
   EXPECT_EQ(padded, packed);
 }
 
+TEST_F(ActTrainerTest, ASelfMaskHandedOverTrainsAsOneGivenAtTheStart) {
+  // A mirror strut (a wedge of 4 degrees from the chassis to the rim) in a bright grey, and the
+  // calibration with it as the self mask, as the trainer nodelet hands a learned mask over.
+  auto frame = paintFlatFrame(model, pose, 1.0, 1);
+  Calibration masked = cal;
+  masked.camera.self_mask.assign(580 * 580, 0);
+  int strut = 0;
+  for (int v = 0; v < 580; ++v) {
+    for (int u = 0; u < 580; ++u) {
+      const double bearing = std::atan2(v - 290.0, u - 290.0) * 180.0 / M_PI;
+      if (bearing < 30.0 || bearing >= 34.0 || std::hypot(u - 290.0, v - 290.0) >= 286.0) continue;
+      frame.rgb.at<cv::Vec3b>(v, u) = cv::Vec3b(200, 200, 206);
+      masked.camera.self_mask[static_cast<size_t>(v) * 580 + u] = 1;
+      ++strut;
+    }
+  }
+  ASSERT_GT(strut, 2000);
+  ActTrainer from_start(masked);
+  ActTrainer handed_over(cal);
+  handed_over.replaceModel(ExpectedClassModel(masked));
+  const Pose2D poses[3] = {pose, {-1.0, 0.5, 2.0}, {0.5, -2.0, -1.2}};
+  for (int n = 0; n < 12; ++n) {
+    const ImageView image = view(frame.rgb);
+    EXPECT_EQ(handed_over.cycle(image, poses[n % 3]).added, from_start.cycle(image, poses[n % 3]).added);
+  }
+  EXPECT_EQ(handed_over.lut().table(), from_start.lut().table());
+  size_t self = 0;
+  for (size_t i = 0; i < masked.camera.self_mask.size(); ++i) {
+    if (masked.camera.self_mask[i]) self += handed_over.model().camera().ray(i).region == PixelRegion::kSelf;
+  }
+  EXPECT_EQ(self, static_cast<size_t>(strut));
+  // A model of another image size is refused; the trainer keeps its own.
+  Calibration other = cal;
+  other.camera.width = 640;
+  other.camera.height = 480;
+  other.camera.self_mask.clear();
+  EXPECT_THROW(handed_over.replaceModel(ExpectedClassModel(other)), std::invalid_argument);
+  EXPECT_EQ(handed_over.model().camera().width(), 580);
+  handed_over.cycle(view(frame.rgb), pose);
+}
+
 TEST_F(ActTrainerTest, ANewColorSpaceStartsAFreshTable) {
   const auto frame = paintFlatFrame(model, pose, 1.0, 1);
   ActTrainer trainer(cal);

@@ -8,6 +8,7 @@
 #include <ros/ros.h>
 #include <sys/stat.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -36,6 +37,17 @@ bool load(const std::string& name) {
 }
 
 bool unload(const std::string& name) { return act_color_test::unloadNodelet("/self_mask_manager", name); }
+
+// The share of the mask's pixels that `labels` gives black.
+double blackShare(const std::vector<uint8_t>& mask, const sensor_msgs::Image& labels) {
+  size_t in_mask = 0, black = 0;
+  for (size_t i = 0; i < mask.size() && i < labels.data.size(); ++i) {
+    if (!mask[i]) continue;
+    ++in_mask;
+    black += labels.data[i] == core::kBlack;
+  }
+  return in_mask ? static_cast<double>(black) / static_cast<double>(in_mask) : 0.0;
+}
 
 // Family scene 40 (three mirror struts) and its calibration without a self mask, written to
 // `dir`/family_40.yaml.
@@ -69,9 +81,11 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
     nh.setParam(name + "/bootstrap_at_first_pose", true);
   }
   nh.setParam("/drive/trainer/learn_self_mask", true);
+  nh.setParam("/drive/segmentation/calibration", dir + "/family_40.yaml");
   ASSERT_TRUE(ros::service::waitForService("/self_mask_manager/load_nodelet", ros::Duration(30.0)));
   ASSERT_TRUE(load("/drive/trainer"));
   ASSERT_TRUE(load("/still/trainer"));
+  ASSERT_TRUE(act_color_test::loadNodelet("/self_mask_manager", "/drive/segmentation", "act_color/segmentation"));
 
   act_color_test::Waiter waiter;
   size_t tables = 0;
@@ -83,13 +97,35 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
       });
   // The trainer's diagnostics: the poses counted and the time one took.
   std::map<std::string, std::string> diagnostics;
+  std::string segmentation_state;  // the segmentation's diagnostics summary
   ros::Subscriber diag_sub = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
       "/diagnostics", 100, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& m) {
         std::lock_guard<std::mutex> lock(waiter.mutex());
         for (const auto& status : m->status) {
+          if (status.name.find("drive/segmentation") != std::string::npos) segmentation_state = status.message;
           if (status.name.find("drive/trainer") == std::string::npos) continue;
           for (const auto& kv : status.values) diagnostics[kv.key] = kv.value;
         }
+        waiter.notify();
+      });
+  // The mask the trainer uses once it has learned it (latched), and the segmentation's labels.
+  sensor_msgs::ImageConstPtr used_mask;
+  int masks = 0;
+  ros::Subscriber mask_sub =
+      nh.subscribe<sensor_msgs::Image>("/drive/self_mask", 10, [&](const sensor_msgs::ImageConstPtr& m) {
+        std::lock_guard<std::mutex> lock(waiter.mutex());
+        used_mask = m;
+        ++masks;
+        waiter.notify();
+      });
+  const sim::Renderer renderer(calibration, scene.renderer);
+  const std::vector<uint8_t> struts = renderer.strutMask();
+  std::vector<double> struts_black;  // per labelled frame, in order
+  ros::Subscriber labels_sub =
+      nh.subscribe<sensor_msgs::Image>("/drive/labels", 200, [&](const sensor_msgs::ImageConstPtr& m) {
+        const double share = blackShare(struts, *m);
+        std::lock_guard<std::mutex> lock(waiter.mutex());
+        struts_black.push_back(share);
         waiter.notify();
       });
   ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/drive/image", 10);
@@ -97,8 +133,14 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   ros::AsyncSpinner spinner(1);
   spinner.start();
   ASSERT_TRUE(waiter.waitFor(30.0, [&] {
-    return image_pub.getNumSubscribers() >= 1 && pose_pub.getNumSubscribers() >= 1 && lut_sub.getNumPublishers() >= 1;
-  })) << "the trainer did not connect";
+    return image_pub.getNumSubscribers() >= 1 && pose_pub.getNumSubscribers() >= 1 && lut_sub.getNumPublishers() >= 1 &&
+           labels_sub.getNumPublishers() >= 1;
+  })) << "the trainer and the segmentation did not connect";
+  // (One connection per topic to the manager's process, whichever of its nodelets subscribe.) The
+  // segmentation's calibration loaded: no frame dropped.
+  ASSERT_TRUE(waiter.waitFor(30.0, [&] {
+    return !segmentation_state.empty() && segmentation_state.find("loading") == std::string::npos;
+  })) << segmentation_state;
   // Not before the calibration is loaded (it is built off the manager's load path).
   ASSERT_TRUE(ros::service::waitForService("/drive/trainer/save_self_mask", ros::Duration(30.0)));
   const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(30.0);
@@ -110,7 +152,6 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   EXPECT_NE(answer.find("no frame counted yet"), std::string::npos) << answer;
 
   // The drive: each pose for kDriveCyclesPerPose frames at 20 Hz, the pose sent before its image.
-  const sim::Renderer renderer(calibration, scene.renderer);
   sim::Scene drive = scene.scenario.frames.front().scene;
   const std::vector<core::Pose2D> poses = sim::drivePoses(scene, sim::kDrivePoses);
   ASSERT_EQ(poses.size(), static_cast<size_t>(sim::kDrivePoses));
@@ -129,9 +170,32 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   }
   // Every frame trained and its table published: learning holds nothing up.
   EXPECT_TRUE(waiter.waitFor(10.0, [&] { return tables >= sent; })) << tables << " tables for " << sent << " frames";
+  // Every frame labelled. From 8 poses on the mask learned so far is used: the struts are labelled
+  // black (over the field and over the hall) where at the start the table gave them other classes.
+  EXPECT_TRUE(waiter.waitFor(10.0, [&] { return struts_black.size() >= sent; }))
+      << struts_black.size() << " labels for " << sent << " frames";
+  ASSERT_TRUE(waiter.waitFor(10.0, [&] { return used_mask != nullptr; })) << "no self mask used";
+  {
+    std::lock_guard<std::mutex> lock(waiter.mutex());
+    ASSERT_FALSE(struts_black.empty());
+    std::printf("struts labelled black: %.3f in the first frame, %.3f in the last; %d masks used\n",
+                struts_black.front(), struts_black.back(), masks);
+    EXPECT_LT(struts_black.front(), 0.8);
+    EXPECT_GT(struts_black.back(), 0.9);
+    EXPECT_GE(masks, 1);
+    EXPECT_EQ(used_mask->encoding, "mono8");
+    ASSERT_EQ(used_mask->data.size(), struts.size());
+    size_t on = 0, off = 0;
+    for (size_t i = 0; i < struts.size(); ++i) (struts[i] ? on : off) += used_mask->data[i] != 0;
+    std::printf("the mask in use: %zu strut pixels, %zu others\n", on, off);
+    EXPECT_GT(on, 0.8 * static_cast<double>(std::count(struts.begin(), struts.end(), 1)));
+    EXPECT_LT(off, 0.01 * static_cast<double>(on));
+  }
 
   const std::string poses_key = "self mask learned from (distinct poses)";
   EXPECT_TRUE(waiter.waitFor(10.0, [&] { return diagnostics[poses_key] == "24"; })) << diagnostics[poses_key];
+  EXPECT_TRUE(waiter.waitFor(10.0, [&] { return std::atoi(diagnostics["self mask in use (pixels)"].c_str()) > 1000; }))
+      << diagnostics["self mask in use (pixels)"];
   {
     std::lock_guard<std::mutex> lock(waiter.mutex());
     std::printf("diagnostics: %s %s, last pose counted in %s ms\n", poses_key.c_str(), diagnostics[poses_key].c_str(),
@@ -154,7 +218,6 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   const cv::Mat mask = cv::imread(dir + "/lut/self_mask.png", cv::IMREAD_GRAYSCALE);
   ASSERT_EQ(mask.cols, calibration.camera.width);
   ASSERT_EQ(mask.rows, calibration.camera.height);
-  const std::vector<uint8_t> struts = renderer.strutMask();
   size_t on = 0, off = 0, strut_pixels = 0;
   for (size_t i = 0; i < struts.size(); ++i) {
     strut_pixels += struts[i];
@@ -186,6 +249,7 @@ TEST(SelfMask, TheTrainerLearnsTheStrutsWhileTheRobotDrives) {
   const auto off_answer = saveSelfMask("/still/trainer", "");
   EXPECT_FALSE(off_answer.success);
   EXPECT_NE(off_answer.message.find("~learn_self_mask is off"), std::string::npos) << off_answer.message;
+  EXPECT_TRUE(act_color_test::unloadNodelet("/self_mask_manager", "/drive/segmentation"));
 }
 
 // The learner's thread goes with its nodelet: unloaded while frames at new poses keep coming (a

@@ -202,6 +202,11 @@ class ActTrainer {
 
   // New parameters keep the table and clusters unless lut_bits changes.
   void setParams(const ActParams& params);
+  // The camera model from now on, e.g. one whose calibration has the own robot's pixels learned
+  // while the robot drives as its self mask (they train nothing, 2.4 does not look at them). The
+  // table, the clusters and every count stay. Building a model takes some 10 ms at 640x480: build it
+  // off the image's thread and hand it over. Throws std::invalid_argument for another image size.
+  void replaceModel(ExpectedClassModel model);
   const ActParams& params() const { return params_; }
   // Empty table, clusters at eq. 2-3.
   void reset(ColorSpace space);
@@ -349,6 +354,8 @@ class ActTrainer {
   void removeCell(uint32_t cell);
   void rebuildMapped();
   bool mapped(uint32_t cell) const { return (mapped_[cell >> 6] >> (cell & 63)) & 1u; }
+  // chassis_pixels_ of model_.
+  void findChassisPixels();
 
   ExpectedClassModel model_;
   ActParams params_;

@@ -11,6 +11,7 @@
 
 #include "act_color/core/calibration.hpp"
 #include "act_color/core/color_lut.hpp"
+#include "act_color/core/expected_class_model.hpp"
 #include "act_color/core/self_mask_learner.hpp"
 #include "act_color/core/types.hpp"
 
@@ -22,6 +23,10 @@ namespace ros_conversions {
 // worker takes one only when it is idle and the pose is new to the learner
 // (SelfMaskLearner::isNewPose), and only then copies the table. Training never waits for it: a
 // frame offered while one is being counted is passed over (the next new pose comes soon).
+// From SelfMaskLearner::kMinPosesForConstancy distinct poses on, whenever the mask learned differs
+// from the one last handed over in more than kApplyChangedFraction of the image's pixels, the worker
+// also builds the camera model with it (and the calibration's own mask) as the self mask, for the
+// trainer to take (takeLearnedModel).
 class SelfMaskWorker {
  public:
   explicit SelfMaskWorker(const core::Calibration& calibration);
@@ -46,6 +51,18 @@ class SelfMaskWorker {
   // SelfMaskLearner::kHeadingSectors). Waits for a frame being counted.
   core::CameraCalibration learned(int* poses, size_t* headings) const;
 
+  // A mask to use from now on, built on the worker's thread: the camera model for
+  // core::ActTrainer::replaceModel and the camera with the mask (for core::Segmenter).
+  struct LearnedModel {
+    core::ExpectedClassModel model;
+    core::CameraCalibration camera;
+    int poses = 0;      // the distinct poses it was learned from
+    size_t pixels = 0;  // in the mask
+  };
+  // The newest such model not yet taken, once (nullptr when there is none).
+  std::unique_ptr<LearnedModel> takeLearnedModel();
+  static constexpr double kApplyChangedFraction = 0.001;
+
  private:
   struct Job {
     sensor_msgs::ImageConstPtr image;
@@ -53,8 +70,10 @@ class SelfMaskWorker {
     core::ColorLut lut;
   };
   void run();
+  // With learner_mutex_ held: the model of the mask learned so far, when it is to be handed over.
+  std::unique_ptr<LearnedModel> buildModelIfChanged(int poses);
 
-  const core::CameraCalibration camera_;
+  const core::Calibration calibration_;
   // The learner, under learner_mutex_ (held while a frame is counted).
   mutable std::mutex learner_mutex_;
   core::SelfMaskLearner learner_;
@@ -65,7 +84,9 @@ class SelfMaskWorker {
   bool busy_ = false, stop_ = false;
   std::optional<core::Pose2D> last_taken_;
   Progress progress_;
-  std::thread thread_;  // last: starts once everything above is built
+  std::unique_ptr<LearnedModel> learned_model_;  // not yet taken
+  std::vector<uint8_t> handed_over_;             // the mask of the last model built (worker's thread only)
+  std::thread thread_;                           // last: starts once everything above is built
 };
 
 }  // namespace ros_conversions
