@@ -33,6 +33,8 @@ class BadInputs : public ::testing::Test {
     model_ = std::make_unique<core::ExpectedClassModel>(core::loadCalibration(path));
     image_pub_ = nh_.advertise<sensor_msgs::Image>("/omni/image_raw", 50);
     pose_pub_ = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("/localization/pose", 50);
+    // A learned self mask as the trainer sends it with ~learn_self_mask (off here).
+    self_mask_pub_ = nh_.advertise<sensor_msgs::Image>("/act/self_mask", 50);
     log_sub_ = nh_.subscribe<rosgraph_msgs::Log>("/rosout", 1000, [this](const rosgraph_msgs::LogConstPtr& m) {
       if (m->name != "/act_manager") return;
       std::lock_guard<std::mutex> lock(waiter_.mutex());
@@ -55,6 +57,7 @@ class BadInputs : public ::testing::Test {
     ASSERT_TRUE(waiter_.waitFor(30.0,
                                 [this] {
                                   return image_pub_.getNumSubscribers() >= 1 && pose_pub_.getNumSubscribers() >= 1 &&
+                                         self_mask_pub_.getNumSubscribers() >= 1 &&
                                          labels_sub_.getNumPublishers() >= 1 && lut_sub_.getNumPublishers() >= 1 &&
                                          log_sub_.getNumPublishers() >= 1;
                                 }))
@@ -77,7 +80,7 @@ class BadInputs : public ::testing::Test {
   ros::NodeHandle nh_;
   ros::AsyncSpinner spinner_{2};
   std::unique_ptr<core::ExpectedClassModel> model_;
-  ros::Publisher image_pub_, pose_pub_;
+  ros::Publisher image_pub_, pose_pub_, self_mask_pub_;
   ros::Subscriber log_sub_, labels_sub_, lut_sub_;
   act_color_test::Waiter waiter_;
   std::vector<rosgraph_msgs::LogConstPtr> logs_;
@@ -122,7 +125,10 @@ TEST_F(BadInputs, ThrottledErrorsNoCrashStillWorking) {
   rolled.pose.pose.orientation.y = 0.0;
   rolled.pose.pose.orientation.z = 0.0;
   rolled.pose.pose.orientation.w = std::sqrt(0.5);
+  // 6. A self mask of another size than the calibration's (the segmentation keeps its own).
+  cv::Mat small_mask(100, 100, CV_8UC1, cv::Scalar(255));
   for (int i = 0; i < kRepeats; ++i) {
+    self_mask_pub_.publish(makeImage(small_mask, "mono8", ros::Time::now()));
     image_pub_.publish(makeImage(mono, "mono8", ros::Time::now()));
     image_pub_.publish(makeImage(small, "rgb8", ros::Time::now()));
     pose_pub_.publish(makePose(nan_pose, ros::Time::now()));
@@ -135,8 +141,9 @@ TEST_F(BadInputs, ThrottledErrorsNoCrashStillWorking) {
   EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "NaN"));
   EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "is off the field"));
   EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "tilted by 90"));
+  EXPECT_TRUE(waitForLog(rosgraph_msgs::Log::ERROR, "the trainer's self mask is not used: image is 100x100 px"));
 
-  // 6. Still alive and working: a good pose and image are trained and segmented. Pose and image
+  // 7. Still alive and working: a good pose and image are trained and segmented. Pose and image
   // come on different connections, so the image may overtake its pose: then the trainer holds it
   // until the next image (README, act_trainer) and its table comes one frame later. Good frames
   // are sent until a table stamped with any of them has come.
@@ -189,12 +196,14 @@ TEST_F(BadInputs, ThrottledErrorsNoCrashStillWorking) {
   EXPECT_GT(accuracy, 0.8);
   // Throttled: one message per call site and throttle period, not one per bad input.
   const int encoding_errors = countLogs(rosgraph_msgs::Log::ERROR, "unsupported encoding");
-  const int size_errors = countLogs(rosgraph_msgs::Log::ERROR, "100x100");
+  const int mask_errors = countLogs(rosgraph_msgs::Log::ERROR, "self mask is not used");
+  const int size_errors = countLogs(rosgraph_msgs::Log::ERROR, "100x100") - mask_errors;
   const int nan_errors = countLogs(rosgraph_msgs::Log::ERROR, "NaN");
-  std::printf("log messages for %d bad inputs each: encoding %d, size %d, NaN pose %d\n", kRepeats, encoding_errors,
-              size_errors, nan_errors);
+  std::printf("log messages for %d bad inputs each: encoding %d, size %d, NaN pose %d, self mask %d\n", kRepeats,
+              encoding_errors, size_errors, nan_errors, mask_errors);
   EXPECT_LE(encoding_errors, 2);  // trainer and segmentation, once each
   EXPECT_LE(size_errors, 2);
+  EXPECT_LE(mask_errors, 1);
   EXPECT_LE(nan_errors, 2);  // one pose source per nodelet, shared throttle
 }
 
