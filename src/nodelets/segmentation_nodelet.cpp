@@ -365,12 +365,13 @@ bool SegmentationNodelet::useSelfMask(const sensor_msgs::Image& msg, std::string
     *error = "its data is shorter than its step and height say";
     return false;
   }
-  camera.self_mask.assign(static_cast<size_t>(msg.width) * msg.height, 0);
+  // The calibration's own mask stays part of it (the trainer sends the two together).
+  camera.self_mask.resize(static_cast<size_t>(msg.width) * msg.height, 0);
   size_t pixels = 0;
   for (uint32_t v = 0; v < msg.height; ++v) {
     for (uint32_t u = 0; u < msg.width; ++u) {
-      const bool own = msg.data[static_cast<size_t>(v) * msg.step + u] != 0;
-      camera.self_mask[static_cast<size_t>(v) * msg.width + u] = own;
+      uint8_t& own = camera.self_mask[static_cast<size_t>(v) * msg.width + u];
+      own = own || msg.data[static_cast<size_t>(v) * msg.step + u] != 0;
       pixels += own;
     }
   }
