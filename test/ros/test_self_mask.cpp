@@ -296,6 +296,15 @@ TEST(SelfMask, UnloadingWhileLearningLeavesTheManagerRunning) {
       ros::WallDuration(0.01).sleep();
     }
     ASSERT_TRUE(unload("/cycle/trainer")) << "round " << round;
+    // The manager destroys an unloaded nodelet once its callback in progress (here a frame being
+    // trained) returns, after the unload service has answered; a nodelet of the same name loaded
+    // before that found its services still advertised by the old one (under ASan: "Tried to
+    // advertise a service that is already advertised", and no ~save_self_mask for 30 s).
+    const ros::WallTime gone_by = ros::WallTime::now() + ros::WallDuration(30.0);
+    while (ros::service::exists("/cycle/trainer/save_self_mask", false) && ros::WallTime::now() < gone_by) {
+      ros::WallDuration(0.05).sleep();
+    }
+    EXPECT_FALSE(ros::service::exists("/cycle/trainer/save_self_mask", false)) << "round " << round;
   }
   EXPECT_TRUE(load("/cycle/trainer"));
   EXPECT_TRUE(unload("/cycle/trainer"));
