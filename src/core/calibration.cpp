@@ -204,10 +204,8 @@ void readSelfMask(CameraCalibration& c, const std::string& source) {
          "'" + path + "' is " + std::to_string(mask.cols) + "x" + std::to_string(mask.rows) + " px, the camera is " +
              std::to_string(c.width) + "x" + std::to_string(c.height));
   }
-  c.self_mask.assign(static_cast<size_t>(c.width) * c.height, 0);
-  for (int v = 0; v < mask.rows; ++v) {
-    for (int u = 0; u < mask.cols; ++u) c.self_mask[static_cast<size_t>(v) * c.width + u] = mask.at<uint8_t>(v, u) != 0;
-  }
+  c.self_mask.clear();
+  addSelfMask(c, mask.data, mask.cols, mask.rows, mask.step);
 }
 
 FieldCalibration parseField(MapReader field) {
@@ -429,14 +427,31 @@ std::string toYaml(const Calibration& calibration) {
   return s.str();
 }
 
-std::vector<uint8_t> encodeSelfMask(const CameraCalibration& camera) {
+std::vector<uint8_t> selfMaskImage(const CameraCalibration& camera) {
   if (camera.self_mask.size() != static_cast<size_t>(camera.width) * camera.height)
     throw CalibrationError("the self mask does not match the camera's size");
-  cv::Mat image(camera.height, camera.width, CV_8UC1);
-  for (int v = 0; v < camera.height; ++v) {
-    for (int u = 0; u < camera.width; ++u)
-      image.at<uint8_t>(v, u) = camera.self_mask[static_cast<size_t>(v) * camera.width + u] ? 255 : 0;
+  std::vector<uint8_t> image(camera.self_mask.size());
+  for (size_t i = 0; i < image.size(); ++i) image[i] = camera.self_mask[i] ? 255 : 0;
+  return image;
+}
+
+void addSelfMask(CameraCalibration& camera, const uint8_t* image, int width, int height, size_t step) {
+  if (width != camera.width || height != camera.height) {
+    throw CalibrationError("a self mask of " + std::to_string(width) + "x" + std::to_string(height) +
+                           " px for a camera of " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
   }
+  camera.self_mask.resize(static_cast<size_t>(width) * height, 0);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) {
+      uint8_t& own = camera.self_mask[static_cast<size_t>(v) * width + u];
+      own = own || image[static_cast<size_t>(v) * step + u] != 0;
+    }
+  }
+}
+
+std::vector<uint8_t> encodeSelfMask(const CameraCalibration& camera) {
+  std::vector<uint8_t> pixels = selfMaskImage(camera);
+  const cv::Mat image(camera.height, camera.width, CV_8UC1, pixels.data());
   std::vector<uint8_t> png;
   bool encoded = false;
   try {

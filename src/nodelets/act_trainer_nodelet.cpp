@@ -619,20 +619,19 @@ void ActTrainerNodelet::useLearnedSelfMask(const std_msgs::Header& header) {
   std::unique_ptr<ros_conversions::SelfMaskWorker::LearnedModel> learned = self_mask_->takeLearnedModel();
   if (!learned) return;
   const auto start = std::chrono::steady_clock::now();
+  segmenter_ = std::make_unique<core::Segmenter>(learned->model.camera().calibration());
+  auto mask = boost::make_shared<sensor_msgs::Image>();
+  mask->data = core::selfMaskImage(learned->model.camera().calibration());
   trainer_->replaceModel(std::move(learned->model));
-  segmenter_ = std::make_unique<core::Segmenter>(learned->camera);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   ++self_masks_used_;
   self_mask_pixels_ = learned->pixels;
   self_mask_poses_ = learned->poses;
-  auto mask = boost::make_shared<sensor_msgs::Image>();
   mask->header = header;
   mask->encoding = "mono8";
-  mask->width = static_cast<uint32_t>(learned->camera.width);
-  mask->height = static_cast<uint32_t>(learned->camera.height);
+  mask->width = static_cast<uint32_t>(trainer_->model().camera().width());
+  mask->height = static_cast<uint32_t>(trainer_->model().camera().height());
   mask->step = mask->width;
-  mask->data.resize(learned->camera.self_mask.size());
-  for (size_t i = 0; i < mask->data.size(); ++i) mask->data[i] = learned->camera.self_mask[i] ? 255 : 0;
   self_mask_pub_.publish(mask);
   NODELET_INFO(
       "the own robot's pixels learned from %d distinct poses (%zu px) are used from the image stamped %.3f on "

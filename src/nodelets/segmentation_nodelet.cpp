@@ -10,6 +10,7 @@
 #include <ros/ros.h>
 #include <std_msgs/UInt64MultiArray.h>
 
+#include <algorithm>
 #include <boost/make_shared.hpp>
 #include <chrono>
 #include <cmath>
@@ -102,7 +103,6 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::unique_ptr<core::OmniCameraModel> camera_;
   // Replaced (not changed) when a learned self mask comes: process() classifies with its own copy.
   std::shared_ptr<const core::Segmenter> segmenter_;
-  core::CameraCalibration camera_calibration_;    // the calibration's, for a learned self mask
   sensor_msgs::ImageConstPtr pending_self_mask_;  // came while the calibration was loading
   size_t self_mask_pixels_ = 0;                   // of the learned self mask in use
   // No segmenter yet and no error: the calibration is being loaded (segmenter_, camera_ and field_
@@ -215,7 +215,6 @@ void SegmentationNodelet::loadCalibration() {
     std::lock_guard<std::mutex> lock(mutex_);
     camera_ = std::move(camera);
     segmenter_ = std::move(segmenter);
-    camera_calibration_ = calibration.camera;
     field_ = calibration.field;
     lazy = lazy_;
     std::string error;
@@ -353,7 +352,7 @@ void SegmentationNodelet::onSelfMask(const sensor_msgs::ImageConstPtr& msg) {
 }
 
 bool SegmentationNodelet::useSelfMask(const sensor_msgs::Image& msg, std::string* error) {
-  core::CameraCalibration camera = camera_calibration_;
+  core::CameraCalibration camera = camera_->calibration();
   if (msg.encoding != "mono8") {
     *error = "encoding '" + msg.encoding + "', not mono8";
     return false;
@@ -366,18 +365,10 @@ bool SegmentationNodelet::useSelfMask(const sensor_msgs::Image& msg, std::string
     return false;
   }
   // The calibration's own mask stays part of it (the trainer sends the two together).
-  camera.self_mask.resize(static_cast<size_t>(msg.width) * msg.height, 0);
-  size_t pixels = 0;
-  for (uint32_t v = 0; v < msg.height; ++v) {
-    for (uint32_t u = 0; u < msg.width; ++u) {
-      uint8_t& own = camera.self_mask[static_cast<size_t>(v) * msg.width + u];
-      own = own || msg.data[static_cast<size_t>(v) * msg.step + u] != 0;
-      pixels += own;
-    }
-  }
+  core::addSelfMask(camera, msg.data.data(), camera.width, camera.height, msg.step);
   camera.self_mask_file.clear();
   segmenter_ = std::make_shared<const core::Segmenter>(camera);
-  self_mask_pixels_ = pixels;
+  self_mask_pixels_ = static_cast<size_t>(std::count(camera.self_mask.begin(), camera.self_mask.end(), 1));
   return true;
 }
 

@@ -1,5 +1,6 @@
 #include "act_color/ros/self_mask_worker.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "act_color/core/image_view.hpp"
@@ -55,26 +56,19 @@ std::unique_ptr<SelfMaskWorker::LearnedModel> SelfMaskWorker::buildModelIfChange
   if (poses < core::SelfMaskLearner::kMinPosesForConstancy) return nullptr;
   const std::vector<uint8_t> mask = learner_.mask();
   if (handed_over_.size() != mask.size()) handed_over_.assign(mask.size(), 0);
-  size_t changed = 0, pixels = 0;
-  for (size_t i = 0; i < mask.size(); ++i) {
-    changed += (mask[i] != 0) != (handed_over_[i] != 0);
-    pixels += mask[i] != 0;
-  }
-  if (pixels == 0 || static_cast<double>(changed) <= kApplyChangedFraction * static_cast<double>(mask.size())) {
+  size_t changed = 0;
+  for (size_t i = 0; i < mask.size(); ++i) changed += (mask[i] != 0) != (handed_over_[i] != 0);
+  if (std::count(mask.begin(), mask.end(), 0) == static_cast<long>(mask.size()) ||
+      static_cast<double>(changed) <= kApplyChangedFraction * static_cast<double>(mask.size())) {
     return nullptr;
   }
   // The calibration's own mask (a team's edits) stays part of it.
   core::Calibration calibration = calibration_;
-  std::vector<uint8_t>& in_use = calibration.camera.self_mask;
-  if (in_use.size() != mask.size()) in_use.assign(mask.size(), 0);
-  pixels = 0;
-  for (size_t i = 0; i < mask.size(); ++i) {
-    in_use[i] = in_use[i] || mask[i];
-    pixels += in_use[i];
-  }
+  const core::CameraCalibration& camera = calibration.camera;
+  core::addSelfMask(calibration.camera, mask.data(), camera.width, camera.height, static_cast<size_t>(camera.width));
   calibration.camera.self_mask_file.clear();
-  auto learned = std::unique_ptr<LearnedModel>(
-      new LearnedModel{core::ExpectedClassModel(calibration), calibration.camera, poses, pixels});
+  const auto pixels = static_cast<size_t>(std::count(camera.self_mask.begin(), camera.self_mask.end(), 1));
+  auto learned = std::unique_ptr<LearnedModel>(new LearnedModel{core::ExpectedClassModel(calibration), poses, pixels});
   handed_over_ = mask;
   return learned;
 }

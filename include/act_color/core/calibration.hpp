@@ -104,7 +104,13 @@ void validateCalibration(const Calibration& calibration, const std::string& sour
 // YAML text in the contract's format; parseCalibration(toYaml(c)) == c (the self mask's file name
 // is written, its pixels are saved with saveSelfMask).
 std::string toYaml(const Calibration& calibration);
-// camera.self_mask as the bytes of a PNG (255 = own robot); throws CalibrationError when the mask
+// camera.self_mask as a grey image's pixels, row by row (255 = own robot); throws CalibrationError
+// when the mask does not match the camera's size.
+std::vector<uint8_t> selfMaskImage(const CameraCalibration& camera);
+// Adds the pixels of a grey image of the camera's size (rows `step` bytes apart, nonzero = own
+// robot) to camera.self_mask (made when empty); throws CalibrationError for another size.
+void addSelfMask(CameraCalibration& camera, const uint8_t* image, int width, int height, size_t step);
+// camera.self_mask as the bytes of a PNG (selfMaskImage); throws CalibrationError when the mask
 // does not match the camera's size.
 std::vector<uint8_t> encodeSelfMask(const CameraCalibration& camera);
 // Writes encodeSelfMask(camera) to `path` atomically (a temporary file beside it, renamed over it);

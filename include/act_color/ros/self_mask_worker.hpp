@@ -52,10 +52,9 @@ class SelfMaskWorker {
   core::CameraCalibration learned(int* poses, size_t* headings) const;
 
   // A mask to use from now on, built on the worker's thread: the camera model for
-  // core::ActTrainer::replaceModel and the camera with the mask (for core::Segmenter).
+  // core::ActTrainer::replaceModel (its camera().calibration() has the mask, for core::Segmenter).
   struct LearnedModel {
     core::ExpectedClassModel model;
-    core::CameraCalibration camera;
     int poses = 0;      // the distinct poses it was learned from
     size_t pixels = 0;  // in the mask
   };
