@@ -250,5 +250,24 @@ std::vector<uint8_t> SelfMaskLearner::mask() const {
   return out;
 }
 
+std::optional<Calibration> SelfMaskHandOver::next(const SelfMaskLearner& learner) {
+  if (learner.frames() < SelfMaskLearner::kMinPosesForConstancy) return std::nullopt;
+  const std::vector<uint8_t> mask = learner.mask();
+  if (handed_over_.size() != mask.size()) handed_over_.assign(mask.size(), 0);
+  size_t changed = 0;
+  for (size_t i = 0; i < mask.size(); ++i) changed += (mask[i] != 0) != (handed_over_[i] != 0);
+  if (std::count(mask.begin(), mask.end(), 0) == static_cast<long>(mask.size()) ||
+      static_cast<double>(changed) <= kChangedFraction * static_cast<double>(mask.size())) {
+    return std::nullopt;
+  }
+  Calibration calibration = calibration_;
+  CameraCalibration& camera = calibration.camera;
+  addSelfMask(camera, mask.data(), camera.width, camera.height, static_cast<size_t>(camera.width));
+  camera.self_mask_file.clear();
+  pixels_ = static_cast<size_t>(std::count(camera.self_mask.begin(), camera.self_mask.end(), 1));
+  handed_over_ = mask;
+  return calibration;
+}
+
 }  // namespace core
 }  // namespace act_color

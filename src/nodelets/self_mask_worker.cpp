@@ -1,6 +1,5 @@
 #include "act_color/ros/self_mask_worker.hpp"
 
-#include <algorithm>
 #include <chrono>
 
 #include "act_color/core/image_view.hpp"
@@ -10,7 +9,7 @@ namespace act_color {
 namespace ros_conversions {
 
 SelfMaskWorker::SelfMaskWorker(const core::Calibration& calibration)
-    : calibration_(calibration), learner_(calibration), thread_([this] { run(); }) {}
+    : calibration_(calibration), learner_(calibration), hand_over_(calibration), thread_([this] { run(); }) {}
 
 SelfMaskWorker::~SelfMaskWorker() {
   {
@@ -53,24 +52,10 @@ std::unique_ptr<SelfMaskWorker::LearnedModel> SelfMaskWorker::takeLearnedModel()
 }
 
 std::unique_ptr<SelfMaskWorker::LearnedModel> SelfMaskWorker::buildModelIfChanged(int poses) {
-  if (poses < core::SelfMaskLearner::kMinPosesForConstancy) return nullptr;
-  const std::vector<uint8_t> mask = learner_.mask();
-  if (handed_over_.size() != mask.size()) handed_over_.assign(mask.size(), 0);
-  size_t changed = 0;
-  for (size_t i = 0; i < mask.size(); ++i) changed += (mask[i] != 0) != (handed_over_[i] != 0);
-  if (std::count(mask.begin(), mask.end(), 0) == static_cast<long>(mask.size()) ||
-      static_cast<double>(changed) <= kApplyChangedFraction * static_cast<double>(mask.size())) {
-    return nullptr;
-  }
-  // The calibration's own mask (a team's edits) stays part of it.
-  core::Calibration calibration = calibration_;
-  const core::CameraCalibration& camera = calibration.camera;
-  core::addSelfMask(calibration.camera, mask.data(), camera.width, camera.height, static_cast<size_t>(camera.width));
-  calibration.camera.self_mask_file.clear();
-  const auto pixels = static_cast<size_t>(std::count(camera.self_mask.begin(), camera.self_mask.end(), 1));
-  auto learned = std::unique_ptr<LearnedModel>(new LearnedModel{core::ExpectedClassModel(calibration), poses, pixels});
-  handed_over_ = mask;
-  return learned;
+  std::optional<core::Calibration> calibration = hand_over_.next(learner_);
+  if (!calibration) return nullptr;
+  return std::unique_ptr<LearnedModel>(
+      new LearnedModel{core::ExpectedClassModel(*calibration), poses, hand_over_.pixels()});
 }
 
 void SelfMaskWorker::run() {

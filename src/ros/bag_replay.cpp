@@ -20,6 +20,7 @@
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <vector>
@@ -250,9 +251,15 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
   *writing_output = true;
 
   core::ActTrainer trainer(calibration, options.params);
-  const core::Segmenter segmenter(calibration.camera);
+  auto segmenter = std::make_unique<const core::Segmenter>(calibration.camera);
+  // --learn-self-mask: learned and used from the next frame on as the trainer's ~learn_self_mask
+  // does (core::SelfMaskHandOver), so that a replay gives the figures of the robot.
   std::unique_ptr<core::SelfMaskLearner> self_mask;
-  if (!options.self_mask_png.empty()) self_mask = std::make_unique<core::SelfMaskLearner>(calibration);
+  std::unique_ptr<core::SelfMaskHandOver> hand_over;
+  if (!options.self_mask_png.empty()) {
+    self_mask = std::make_unique<core::SelfMaskLearner>(calibration);
+    hand_over = std::make_unique<core::SelfMaskHandOver>(calibration);
+  }
   ReplayResult result;
   result.evaluation = core::RunEvaluation(options.adapt_frames);
   cv::Mat labels(calibration.camera.height, calibration.camera.width, CV_8UC1);
@@ -303,8 +310,16 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
       } else {
         ++result.without_pose;
       }
-      segmenter.classify(trainer.lut(), view, labels);
+      segmenter->classify(trainer.lut(), view, labels);
       trainer.labelBall(stats, labels);
+      if (hand_over) {
+        if (std::optional<core::Calibration> masked = hand_over->next(*self_mask)) {
+          trainer.replaceModel(core::ExpectedClassModel(*masked));
+          segmenter = std::make_unique<const core::Segmenter>(masked->camera);
+          if (result.self_masks_used++ == 0) result.self_mask_first_frame = result.images + 1;
+          result.self_mask_used_pixels = hand_over->pixels();
+        }
+      }
     }
     out.bag().write("/segmentation/labels", m.getTime(), ros_conversions::labelsToMsg(labels, image->header));
     if (result.images % options.lut_every == 0) {

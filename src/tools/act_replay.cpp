@@ -37,7 +37,8 @@ void printUsage(std::ostream& out) {
          "  --lut-every N        write /act/color_lut with every n-th frame (default 1)\n"
          "  --adapt-frames N     frames after each event left out of the *_ad figures (default 12)\n"
          "  --csv FILE           per-frame recall and precision per class\n"
-         "  --learn-self-mask F  learn the own robot's pixels (struts, cables) and write them to the PNG F\n"
+         "  --learn-self-mask F  learn the own robot's pixels (struts, cables), use them from the 8th distinct pose\n"
+         "                       on (as the trainer's ~learn_self_mask) and write them to the PNG F\n"
          "  --png DIR            input | classified | truth as PNG for every n-th frame (--png-every N, 10;\n"
          "                       DIR is made if missing)\n"
          "  --no-progress        no progress lines on stderr\n"
@@ -183,6 +184,12 @@ int main(int argc, char** argv) {
           "act_replay: self mask learned from %d poses: %.2f%% of the imaged pixels; wrote %s (set camera.self_mask "
           "to it)\n",
           result.self_mask_poses, 100.0 * result.self_mask_fraction, options.self_mask_png.c_str());
+      if (result.self_masks_used > 0) {
+        std::printf(
+            "act_replay: the learned mask was used from frame %zu on (as the trainer's ~learn_self_mask does), "
+            "taken over %zu times, last %zu px\n",
+            result.self_mask_first_frame, result.self_masks_used, result.self_mask_used_pixels);
+      }
       if (result.self_mask_poses < act_color::core::SelfMaskLearner::kMinPosesForConstancy) {
         std::printf(
             "act_replay: fewer than %d distinct poses (%.2f m or %.0f deg apart): only the parts over the field were "

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -184,6 +186,62 @@ TEST(SelfMask, StrutsOverTheHallOnlyAreLearnedFromADrive) {
   // A drive that never turns cannot tell them from a pole far to the side: nothing is learned.
   const Coverage straight = coverage(scene, sim::learnSelfMaskOnDrive(scene, sim::kDrivePoses, false));
   EXPECT_EQ(straight.struts, 0.0);
+}
+
+TEST(SelfMask, TheMaskIsHandedOverFromTheEighthPoseOnWhenItChanged) {
+  // Tuning seed 27's drive (four struts over field and hall), as the trainer's ~learn_self_mask and
+  // act_replay --learn-self-mask use it: a mask to use from kMinPosesForConstancy poses on, again
+  // only when it changed, and a team's own mask in the calibration kept in it.
+  const sim::FamilyScene scene = sim::makeFamilyScene(27);
+  core::Calibration calibration = scene.calibration;
+  const auto& cam = calibration.camera;
+  const size_t pixels = static_cast<size_t>(cam.width) * cam.height;
+  calibration.camera.self_mask.assign(pixels, 0);
+  // A pixel a team masked by hand, halfway between the chassis and the mirror's rim.
+  const auto team_v = static_cast<size_t>(cam.center_v + 0.5 * (cam.chassis_radius_px + cam.mirror_radius_px));
+  const size_t team_pixel = team_v * cam.width + static_cast<size_t>(cam.center_u);
+  calibration.camera.self_mask[team_pixel] = 1;
+  calibration.camera.self_mask_file = "team.png";
+  const sim::Renderer renderer(calibration, scene.renderer);
+  core::ActTrainer trainer(calibration);
+  core::SelfMaskLearner learner(calibration);
+  core::SelfMaskHandOver hand_over(calibration);
+  sim::Scene drive = scene.scenario.frames.front().scene;
+  const std::vector<core::Pose2D> poses = sim::drivePoses(scene, sim::kDrivePoses);
+  ASSERT_EQ(poses.size(), static_cast<size_t>(sim::kDrivePoses));
+  std::vector<int> handed_at;
+  std::optional<core::Calibration> last;
+  for (size_t k = 0; k < poses.size(); ++k) {
+    drive.robot_pose = poses[k];
+    drive.noise_seed = sim::kDriveNoiseSeed + static_cast<uint32_t>(k);
+    const sim::LabeledFrame frame = renderer.render(drive);
+    const auto view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
+    if (k == 0) trainer.bootstrap(view, poses[k], core::kDefaultBootstrapCycles);
+    trainer.cycle(view, poses[k]);
+    learner.add(view, poses[k], trainer.lut());
+    if (std::optional<core::Calibration> next = hand_over.next(learner)) {
+      handed_at.push_back(learner.frames());
+      last = std::move(next);
+    }
+    EXPECT_FALSE(hand_over.next(learner)) << "handed over twice for one pose";
+  }
+  std::printf("handed over at poses");
+  for (const int p : handed_at) std::printf(" %d", p);
+  std::printf(" of %d\n", learner.frames());
+  ASSERT_FALSE(handed_at.empty());
+  EXPECT_EQ(handed_at.front(), core::SelfMaskLearner::kMinPosesForConstancy);
+  EXPECT_LT(handed_at.size(), static_cast<size_t>(learner.frames() - handed_at.front() + 1));  // not at every pose
+  const std::vector<uint8_t>& used = last->camera.self_mask;
+  ASSERT_EQ(used.size(), pixels);
+  EXPECT_EQ(used[team_pixel], 1) << "the calibration's own mask is kept";
+  EXPECT_TRUE(last->camera.self_mask_file.empty());
+  EXPECT_EQ(hand_over.pixels(), static_cast<size_t>(std::count(used.begin(), used.end(), 1)));
+  const Coverage c = coverage(scene, used);
+  EXPECT_GT(c.struts, 0.65);
+  EXPECT_LT(c.others, 0.001);
+  // The trainer takes the model built with it; the struts then train nothing.
+  trainer.replaceModel(core::ExpectedClassModel(*last));
+  EXPECT_EQ(trainer.model().camera().calibration().self_mask, used);
 }
 
 TEST(SelfMask, NoStrutsNoMask) {

@@ -595,6 +595,8 @@ TEST(ActReplay, LearnsTheSelfMaskFromADriveAndItsStrutsAreBlack) {
   ASSERT_EQ(learned.exit_code, 0) << learned.output;
   EXPECT_NE(learned.output.find("self mask learned from 13 poses"), std::string::npos) << learned.output;
   EXPECT_EQ(learned.output.find("fewer than"), std::string::npos) << learned.output;
+  // Used while the replay runs, from the frame after the 8th distinct pose, as on the robot.
+  EXPECT_NE(learned.output.find("the learned mask was used from frame"), std::string::npos) << learned.output;
   const cv::Mat mask = cv::imread(dir + "/mask.png", cv::IMREAD_GRAYSCALE);
   ASSERT_EQ(mask.cols, 640);
   ASSERT_EQ(mask.rows, 480);
@@ -616,22 +618,28 @@ TEST(ActReplay, LearnsTheSelfMaskFromADriveAndItsStrutsAreBlack) {
   yaml.insert(camera + 8, "  self_mask: mask.png\n");
   std::ofstream(dir + "/masked.yaml") << yaml;
   // Black's adapted recall in the brief summary: "  black  all adapt  all adapt".
-  auto blackRecall = [&](const std::string& calibration) {
-    const auto run = act_color_tool_test::runTool("act_replay", bag + " --calibration " + dir + "/" + calibration, dir);
-    EXPECT_EQ(run.exit_code, 0) << run.output;
-    std::istringstream lines(run.output);
+  auto blackRecallIn = [](const std::string& output) {
+    std::istringstream lines(output);
     for (std::string line; std::getline(lines, line);) {
       std::istringstream words(line);
       std::string name;
       double all = 0, adapted = 0;
       if (words >> name >> all >> adapted && name == "black") return adapted;
     }
-    ADD_FAILURE() << "no black line in:\n" << run.output;
+    ADD_FAILURE() << "no black line in:\n" << output;
     return 0.0;
   };
+  auto blackRecall = [&](const std::string& calibration) {
+    const auto run = act_color_tool_test::runTool("act_replay", bag + " --calibration " + dir + "/" + calibration, dir);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    return blackRecallIn(run.output);
+  };
   const double without = blackRecall("family_40.yaml"), with = blackRecall("masked.yaml");
-  std::printf("black recall %.3f without the mask, %.3f with it\n", without, with);
+  const double while_learning = blackRecallIn(learned.output);
+  std::printf("black recall %.3f without the mask, %.3f while learning it, %.3f with it\n", without, while_learning,
+              with);
   EXPECT_GT(with, without + 0.3);
+  EXPECT_GT(while_learning, without + 0.2);  // from the 8th of 13 poses on
 
   // Family scene 0 stands still, then drives: 6 distinct poses, too few to follow the struts over
   // the hall, and the replay says so.
@@ -647,4 +655,5 @@ TEST(ActReplay, LearnsTheSelfMaskFromADriveAndItsStrutsAreBlack) {
   ASSERT_EQ(few.exit_code, 0) << few.output;
   EXPECT_NE(few.output.find("self mask learned from 6 poses"), std::string::npos) << few.output;
   EXPECT_NE(few.output.find("fewer than 8 distinct poses"), std::string::npos) << few.output;
+  EXPECT_EQ(few.output.find("the learned mask was used"), std::string::npos) << few.output;
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "act_color/core/calibration.hpp"
@@ -72,6 +73,27 @@ class SelfMaskLearner {
   int frames_ = 0;
   Pose2D last_pose_;
   uint32_t heading_sectors_ = 0;  // bit k: a pose counted faced sector k
+};
+
+// When a mask being learned is used while the robot plays (the trainer's ~learn_self_mask, act_replay
+// --learn-self-mask): from SelfMaskLearner::kMinPosesForConstancy distinct poses on, whenever the
+// mask differs from the one used last in more than kChangedFraction of the image's pixels. The
+// calibration's own mask (a team's edits) stays part of it.
+class SelfMaskHandOver {
+ public:
+  explicit SelfMaskHandOver(const Calibration& calibration) : calibration_(calibration) {}
+  // The calibration with the learner's mask, united with its own, as the self mask (no
+  // self_mask_file), when it is to be used from now on; nullopt when it is not.
+  std::optional<Calibration> next(const SelfMaskLearner& learner);
+  // Pixels in the mask last handed over (the calibration's own and the learned).
+  size_t pixels() const { return pixels_; }
+
+  static constexpr double kChangedFraction = 0.001;
+
+ private:
+  const Calibration calibration_;
+  std::vector<uint8_t> handed_over_;  // the learned mask last handed over
+  size_t pixels_ = 0;
 };
 
 }  // namespace core

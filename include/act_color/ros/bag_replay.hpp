@@ -32,7 +32,8 @@ struct ReplayOptions {
   size_t png_every = 10;  // of every n-th frame
   bool progress = true;   // a progress line on stderr every few seconds
   // The own robot's pixels learned over the replay (core::SelfMaskLearner) are written here as a
-  // PNG for the calibration's camera.self_mask, when not empty.
+  // PNG for the calibration's camera.self_mask, when not empty. They are also used while the replay
+  // runs, as the trainer nodelet's ~learn_self_mask does (core::SelfMaskHandOver).
   std::string self_mask_png;
 };
 
@@ -47,6 +48,9 @@ struct ReplayResult {
   size_t truth_left_out = 0;      // frames with a truth image left out of the metrics (unusable truth or image)
   int self_mask_poses = 0;        // distinct poses the self mask was learned from
   double self_mask_fraction = 0;  // of the imaged pixels
+  size_t self_masks_used = 0;     // learned masks taken over while the replay ran
+  size_t self_mask_first_frame = 0;  // the first frame that used one (0-based)
+  size_t self_mask_used_pixels = 0;  // in the last one taken over (with the calibration's own mask)
   core::RunEvaluation evaluation;
 };
 

@@ -23,10 +23,9 @@ namespace ros_conversions {
 // worker takes one only when it is idle and the pose is new to the learner
 // (SelfMaskLearner::isNewPose), and only then copies the table. Training never waits for it: a
 // frame offered while one is being counted is passed over (the next new pose comes soon).
-// From SelfMaskLearner::kMinPosesForConstancy distinct poses on, whenever the mask learned differs
-// from the one last handed over in more than kApplyChangedFraction of the image's pixels, the worker
-// also builds the camera model with it (and the calibration's own mask) as the self mask, for the
-// trainer to take (takeLearnedModel).
+// Whenever core::SelfMaskHandOver says the mask learned is to be used, the worker also builds the
+// camera model with it (and the calibration's own mask) as the self mask, for the trainer to take
+// (takeLearnedModel).
 class SelfMaskWorker {
  public:
   explicit SelfMaskWorker(const core::Calibration& calibration);
@@ -60,7 +59,6 @@ class SelfMaskWorker {
   };
   // The newest such model not yet taken, once (nullptr when there is none).
   std::unique_ptr<LearnedModel> takeLearnedModel();
-  static constexpr double kApplyChangedFraction = 0.001;
 
  private:
   struct Job {
@@ -84,7 +82,7 @@ class SelfMaskWorker {
   std::optional<core::Pose2D> last_taken_;
   Progress progress_;
   std::unique_ptr<LearnedModel> learned_model_;  // not yet taken
-  std::vector<uint8_t> handed_over_;             // the mask of the last model built (worker's thread only)
+  core::SelfMaskHandOver hand_over_;             // worker's thread only
   std::thread thread_;                           // last: starts once everything above is built
 };
 
