@@ -265,6 +265,8 @@ void ActParams::set(const std::string& name, const std::string& value) {
     ball_training = boolean();
   } else if (name == "ball_diameter_m") {
     ball_diameter_m = number();
+  } else if (name == "carpet_edge") {
+    carpet_edge = boolean();
   } else {
     throw std::invalid_argument("unknown ACT parameter '" + name + "'");
   }
@@ -288,6 +290,7 @@ void ActParams::switchOffExtensions() {
   lattice_sampling = false;
   pose_check = false;
   ball_training = false;
+  carpet_edge = false;
 }
 
 ActParams ActParams::paper() {
@@ -301,6 +304,7 @@ ActTrainer::ActTrainer(const Calibration& calibration, const ActParams& params)
       params_(params),
       lut_(params.lut_bits),
       rng_(params.seed),
+      carpet_edge_(model_.camera()),
       ball_detector_(model_, 0.5 * params.ball_diameter_m) {
   params_.validate();
   findChassisPixels();
@@ -330,6 +334,7 @@ void ActTrainer::replaceModel(ExpectedClassModel model) {
   model_ = std::move(model);
   findChassisPixels();
   removal_samples_.clear();  // its samples leave out the pixels that are never off the field
+  carpet_edge_ = CarpetEdge(model_.camera());
   ball_detector_ = BallDetector(model_, 0.5 * params_.ball_diameter_m);
 }
 
@@ -1334,6 +1339,10 @@ constexpr double kBallMatchMin = 20.0;
 constexpr size_t kBallAddsPerCycle = 1024;
 
 }  // namespace
+
+uint32_t ActTrainer::unlabelWhiteBeyondCarpet(cv::Mat& labels) const {
+  return params_.carpet_edge ? carpet_edge_.unlabelWhiteBeyond(labels) : 0;
+}
 
 uint32_t ActTrainer::labelBall(const CycleStats& stats, cv::Mat& labels) const {
   if (!stats.ball.seen) return 0;

@@ -256,7 +256,8 @@ bool ActTrainerNodelet::readParams(core::ActParams* params, std::string* error) 
                     readParam(pnh_, "lattice_sampling", &p.lattice_sampling, error) &&
                     readParam(pnh_, "pose_check", &p.pose_check, error) &&
                     readParam(pnh_, "ball_training", &p.ball_training, error) &&
-                    readParam(pnh_, "ball_diameter_m", &p.ball_diameter_m, error);
+                    readParam(pnh_, "ball_diameter_m", &p.ball_diameter_m, error) &&
+                    readParam(pnh_, "carpet_edge", &p.carpet_edge, error);
   if (!read) return false;
   if (seed < 0) {
     *error = "parameter ~seed must be >= 0, is " + std::to_string(seed);
@@ -501,6 +502,7 @@ ActTrainerConfig ActTrainerNodelet::configInEffect() const {
   c.pose_check = p.pose_check;
   c.ball_training = p.ball_training;
   c.ball_diameter_m = p.ball_diameter_m;
+  c.carpet_edge = p.carpet_edge;
   c.max_pose_age = max_pose_age_s_;
   c.tf_timeout = tf_timeout_s_;
   c.publish_lut_every = publish_lut_every_;
@@ -532,6 +534,7 @@ bool ActTrainerNodelet::applyConfig(const ActTrainerConfig& c, std::string* erro
   p.pose_check = c.pose_check;
   p.ball_training = c.ball_training;
   p.ball_diameter_m = c.ball_diameter_m;
+  p.carpet_edge = c.carpet_edge;
   try {
     p.validate();
   } catch (const std::exception& e) {
@@ -764,6 +767,7 @@ void ActTrainerNodelet::publishOutputs(const core::ImageView& view, const sensor
   }
   if (classified_pub_.getNumSubscribers() > 0) {
     segmenter_->classify(trainer_->lut(), view, labels_);
+    trainer_->unlabelWhiteBeyondCarpet(labels_);
     if (trained) trainer_->labelBall(*trained, labels_);
     cv_bridge::CvImage out(header, "rgb8");
     core::colorizeLabels(labels_, out.image);

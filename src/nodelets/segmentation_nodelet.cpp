@@ -27,6 +27,7 @@
 #include "act_color/core/act_trainer.hpp"
 #include "act_color/core/ball_detector.hpp"
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/carpet_edge.hpp"
 #include "act_color/core/feature_extractor.hpp"
 #include "act_color/core/omni_camera_model.hpp"
 #include "act_color/core/segmenter.hpp"
@@ -105,6 +106,10 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::shared_ptr<const core::Segmenter> segmenter_;
   sensor_msgs::ImageConstPtr pending_self_mask_;  // came while the calibration was loading
   size_t self_mask_pixels_ = 0;                   // of the learned self mask in use
+  // ~carpet_edge: white beyond the carpet's edge labelled unknown (core::CarpetEdge, of camera_).
+  std::shared_ptr<const core::CarpetEdge> carpet_edge_;
+  bool carpet_edge_on_ = true;
+  uint32_t beyond_carpet_ = 0;  // pixels it labelled unknown in the last image
   // No segmenter yet and no error: the calibration is being loaded (segmenter_, camera_ and field_
   // follow).
   bool loading() const { return !segmenter_ && config_error_.empty(); }
@@ -162,7 +167,8 @@ bool SegmentationNodelet::configure(std::string* error) {
       !readParam(pnh_, "min_obstacle_run_px", &c.min_obstacle_run_px, error) ||
       !readParam(pnh_, "min_ball_pixels", &c.min_ball_pixels, error) ||
       !readParam(pnh_, "obstacle_merge_m", &c.obstacle_merge_m, error) ||
-      !readParam(pnh_, "ball_diameter_m", &c.ball_diameter_m, error) || !readParam(pnh_, "lazy", &lazy, error) ||
+      !readParam(pnh_, "ball_diameter_m", &c.ball_diameter_m, error) ||
+      !readParam(pnh_, "carpet_edge", &c.carpet_edge, error) || !readParam(pnh_, "lazy", &lazy, error) ||
       !readParam(pnh_, "debug_lut_addresses", &debug, error)) {
     return false;
   }
@@ -208,6 +214,7 @@ void SegmentationNodelet::loadCalibration() {
   const core::Calibration calibration = ros_conversions::loadCalibrationParam(pnh_, &pose_source_, &calibration_path);
   auto camera = std::make_unique<core::OmniCameraModel>(calibration.camera);
   auto segmenter = std::make_shared<const core::Segmenter>(calibration.camera);
+  auto carpet_edge = std::make_shared<const core::CarpetEdge>(*camera);
   bool lazy = false;
   {
     // Set once: images are queued only while segmenter_ is set, so the processing outside the lock
@@ -215,6 +222,7 @@ void SegmentationNodelet::loadCalibration() {
     std::lock_guard<std::mutex> lock(mutex_);
     camera_ = std::move(camera);
     segmenter_ = std::move(segmenter);
+    carpet_edge_ = std::move(carpet_edge);
     field_ = calibration.field;
     lazy = lazy_;
     std::string error;
@@ -264,6 +272,7 @@ bool SegmentationNodelet::applyConfig(const SegmentationConfig& c, std::string* 
   max_wait_s_ = c.max_wait;
   table_history_ = static_cast<size_t>(c.table_history);
   ball_radius_m_ = 0.5 * c.ball_diameter_m;
+  carpet_edge_on_ = c.carpet_edge;
   pose_source_.setMaxAge(c.max_pose_age);
   return true;
 }
@@ -499,13 +508,20 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
   cv::Mat labels;
   sensor_msgs::ImagePtr labels_msg = ros_conversions::newLabelsMsg(*image, &labels);
   std::shared_ptr<const core::Segmenter> segmenter;
+  std::shared_ptr<const core::CarpetEdge> carpet_edge;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     segmenter = segmenter_;
+    if (carpet_edge_on_) carpet_edge = carpet_edge_;
   }
   const auto start = std::chrono::steady_clock::now();
   if (lut) {
     segmenter->classify(ros_conversions::lutView(*lut), view, labels);  // throws for a wrong size or color space
+    const uint32_t unlabelled = carpet_edge ? carpet_edge->unlabelWhiteBeyond(labels) : 0;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      beyond_carpet_ = unlabelled;
+    }
     if (ball) {
       double radius_m = 0;
       {
@@ -628,6 +644,7 @@ void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   }
   status.add("label rate (Hz)", window_.rateHz());
   status.add("own robot's pixels learned by the trainer, labelled black", self_mask_pixels_);
+  status.add("white beyond the carpet's edge labelled unknown (px, last image)", beyond_carpet_);
   status.add("with the table of the same frame (%, last 5 s)", percent(exact, n));
   status.add("with an older or the newest table (%, last 5 s)", percent(stale, n));
   status.add("without a table, all unknown (%, last 5 s)", percent(none, n));

@@ -118,6 +118,7 @@ std::vector<EvalMode> evalModes(bool ablations) {
       {"learned_boundary", [](core::ActParams& p) { p.learned_boundary = false; }},
       {"lattice_sampling", [](core::ActParams& p) { p.lattice_sampling = false; }},
       {"pose_check", [](core::ActParams& p) { p.pose_check = false; }},
+      {"carpet_edge", [](core::ActParams& p) { p.carpet_edge = false; }},
   };
   for (const auto& [name, apply] : off) {
     EvalMode m{"no_" + name, core::ActParams()};
@@ -235,6 +236,7 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
       if (i == 0) trainers[m].bootstrap(view, f.told_pose, std::max(0, options.bootstrap_cycles - 1));
       const core::CycleStats stats = trainers[m].cycle(view, f.told_pose);
       segmenter.classify(trainers[m].lut(), view, labels[m]);
+      trainers[m].unlabelWhiteBeyondCarpet(labels[m]);
       trainers[m].labelBall(stats, labels[m]);
       evaluations[m].addFrame(labels[m], frame.labels);
       BallFigures& b = result.ball[m];

@@ -214,9 +214,15 @@ RealImageResult evaluateRealImage(const RealImage& image,
             variant == "wrong_pose" && f >= kRealFramesBefore && f < kRealFramesBefore + kRealWrongPoseFrames;
         const core::CycleStats stats = trainer.cycle(view, pose_wrong ? wrong_pose : pose);
         const core::ColorLut& lut = trainer.lut();
+        // The labels as the segmentation gives them: the table's, white beyond the carpet's edge
+        // unknown (ActParams::carpet_edge), and the ball's image where the cycle saw it (below). The
+        // figures read the table, but a white the carpet's edge took out counts as unknown.
+        segmenter.classify(lut, view, labels);
+        trainer.unlabelWhiteBeyondCarpet(labels);
         auto classOf = [&](int index) {
           const cv::Vec3b c = frame.at<cv::Vec3b>(index / frame.cols, index % frame.cols);
-          return lut.classOf(c[0], c[1], c[2]);
+          const uint8_t k = lut.classOf(c[0], c[1], c[2]);
+          return k == core::kWhite && labels.ptr<uint8_t>()[index] == core::kUnknown ? uint8_t{core::kUnknown} : k;
         };
         RealFrameFigures fig;
         if (!whites.empty()) {
@@ -236,10 +242,7 @@ RealImageResult evaluateRealImage(const RealImage& image,
         fig.hall_in_field = hall.empty() ? 0.0 : static_cast<double>(in_field) / hall.size();
         fig.hall_as_black = hall.empty() ? 0.0 : static_cast<double>(black) / hall.size();
         fig.hall_as_goal = hall.empty() ? 0.0 : static_cast<double>(goal) / hall.size();
-        // The labels as the segmentation gives them: the table's, and the ball's image where the cycle
-        // saw it (the ball's figures, and the pictures).
-        segmenter.classify(lut, view, labels);
-        trainer.labelBall(stats, labels);
+        trainer.labelBall(stats, labels);  // the ball's figures, and the pictures
         if (image.ball) {
           size_t inside = 0, inside_ball = 0, predicted = 0, predicted_near = 0;
           for (int i = 0; i < frame.rows * frame.cols; ++i) {

@@ -94,8 +94,10 @@ act_color::ColorLutConstPtr trainerCallback(ActTrainer& trainer, const sensor_ms
 
 // The segmentation nodelet's per-image work (src/nodelets/segmentation_nodelet.cpp, process): a
 // view of the message, the labels written straight into a new mono8 message with the shared
-// table (no copy of it), the ball the trainer saw labelled as its image.
-sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter, const core::OmniCameraModel& camera,
+// table (no copy of it), white beyond the carpet's edge unlabelled (~carpet_edge), the ball the
+// trainer saw labelled as its image.
+sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter, const core::CarpetEdge& carpet_edge,
+                                                const core::OmniCameraModel& camera,
                                                 const sensor_msgs::ImageConstPtr& image,
                                                 const act_color::ColorLutConstPtr& lut,
                                                 const core::CycleStats::Ball& ball) {
@@ -105,6 +107,7 @@ sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter
   cv::Mat labels;
   sensor_msgs::ImagePtr labels_msg = conv::newLabelsMsg(*image, &labels);
   segmenter.classify(conv::lutView(*lut), v, labels);
+  carpet_edge.unlabelWhiteBeyond(labels);
   if (ball.seen) core::labelBallImage(camera, 0.11, ball.x_m, ball.y_m, labels);
   return labels_msg;
 }
@@ -114,7 +117,8 @@ sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter
 // segmentation; labels -> a sink.
 class RosPipeline {
  public:
-  RosPipeline(ActTrainer* trainer, const core::Segmenter* segmenter) : trainer_(trainer), segmenter_(segmenter) {
+  RosPipeline(ActTrainer* trainer, const core::Segmenter* segmenter)
+      : trainer_(trainer), segmenter_(segmenter), carpet_edge_(trainer->model().camera()) {
     nh_.setCallbackQueue(&queue_);
     image_pub_ = nh_.advertise<sensor_msgs::Image>("act_benchmark/image", 2);
     lut_pub_ = nh_.advertise<act_color::ColorLut>("act_benchmark/color_lut", 2);
@@ -160,13 +164,15 @@ class RosPipeline {
   }
   void flush() {
     if (!pending_ || !table_ || table_->header.stamp != pending_->header.stamp) return;
-    labels_pub_.publish(segmentationCallback(*segmenter_, trainer_->model().camera(), pending_, table_, ball_));
+    labels_pub_.publish(
+        segmentationCallback(*segmenter_, carpet_edge_, trainer_->model().camera(), pending_, table_, ball_));
     pending_.reset();
   }
   void onLabels(const sensor_msgs::ImageConstPtr&) { ++labels_; }
 
   ActTrainer* trainer_;
   const core::Segmenter* segmenter_;
+  const core::CarpetEdge carpet_edge_;
   ros::CallbackQueue queue_;
   ros::NodeHandle nh_;
   ros::Publisher image_pub_, lut_pub_, labels_pub_;
@@ -273,6 +279,16 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
       });
     }
   }
+  // ~carpet_edge's pass over classified labels (with a copy of the labels, as label_ball).
+  const core::CarpetEdge carpet_edge(trainer.model().camera());
+  {
+    segmenter.classify(trainer.lut(), view(frames[0]), labels);
+    cv::Mat work = labels.clone();
+    add("carpet_edge", [&] {
+      labels.copyTo(work);
+      carpet_edge.unlabelWhiteBeyond(work);
+    });
+  }
   core::LutView lv{trainer.lut().data(), trainer.lut().size(), trainer.lut().bitsPerChannel(), core::ColorSpace::kRgb};
   add("classify_lutview_nodelet", [&] { lut_view_segmenter.classify(lv, view(frames[i++ % frames.size()]), labels); });
   add("cmvision_bitmask", [&] { cmvision.classify(frames[i++ % frames.size()].rgb, labels); });
@@ -293,7 +309,7 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
     core::CycleStats::Ball ball;
     const auto lut = trainerCallback(path_trainer, f.msg, f.pose, &ball);
     balls_seen += ball.seen;
-    segmentationCallback(lut_view_segmenter, path_trainer.model().camera(), f.msg, lut, ball);
+    segmentationCallback(lut_view_segmenter, carpet_edge, path_trainer.model().camera(), f.msg, lut, ball);
   });
   // How many of the path's images had a ball sighting (labelled as its image by the segmentation).
   result.agreement["nodelet_path_ball_sightings"] = static_cast<double>(balls_seen);

@@ -59,6 +59,9 @@ void expectHolds(const sim::RealImageResult& r) {
     // 0.05 on nubot_1; at the lines' ratio of 3, 0.12 on nubot_1_bak_bak after the darkening.
     if (row.mode == "defaults") {
       EXPECT_LE(row.after.hall_as_goal, 0.08) << row.variant;
+      // Nor green and white after it, the 1.5x brightening's saturated walls too (issue 12's 0.15;
+      // since ActParams::carpet_edge at most 0.11 on nubot_1_bak_bak and 0.05 on nubot_1).
+      EXPECT_LE(row.after.hall_in_field, 0.15) << row.variant;
     }
     // The look at the image after the change (act_real_eval --png): the last frame and its labels.
     ASSERT_EQ(row.frame_last.size(), row.labels_last.size()) << row.variant;
@@ -170,16 +173,17 @@ TEST(RealImages, Nubot1) {
     if (row.variant == "brighten") {
       EXPECT_GT(row.table_hall_as_white_after, 0.15);
     }
-    // The same at ACT's own recalls (the defaults' white and green): a lower bound of its hall figure
-    // for any one table over those frames (measured 0.01-0.03 before each change, 0.20 after the
-    // brightening, where ACT shows 0.23 at white recall 0.86: issue 12's 0.15 is out of any fixed
-    // table's reach there).
+    // The same at ACT's own recalls (the defaults' white and green): the least hall figure any one
+    // table gives over those frames (measured 0.01-0.03 before each change, 0.20 after the
+    // brightening: issue 12's 0.15 is out of any fixed table's reach there, and the table alone gave
+    // 0.23 at white recall 0.86). The labels are more than the table: white beyond the carpet's edge
+    // is unknown (ActParams::carpet_edge), and after the brightening they show 0.04 of the hall.
     ASSERT_GE(row.table_hall_as_white_at_mode_after, 0.0) << row.variant;
     ASSERT_GE(row.table_hall_as_green_at_mode_after, 0.0) << row.variant;
     const double bound_after = row.table_hall_as_white_at_mode_after + row.table_hall_as_green_at_mode_after;
-    EXPECT_LE(bound_after, row.after.hall_in_field + 0.01) << row.variant;
     if (row.variant == "brighten") {
       EXPECT_GT(bound_after, 0.15);
+      EXPECT_LT(row.after.hall_in_field, 0.10);
     }
   }
 }

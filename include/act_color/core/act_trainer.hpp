@@ -9,6 +9,7 @@
 
 #include "act_color/core/ball_detector.hpp"
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/carpet_edge.hpp"
 #include "act_color/core/class_cluster.hpp"
 #include "act_color/core/color_lut.hpp"
 #include "act_color/core/expected_class_model.hpp"
@@ -117,6 +118,10 @@ struct ActParams {
   // another class, and 2.4 removes its colors seen off the field like the others'.
   bool ball_training = true;
   double ball_diameter_m = 0.22;  // in [kMinBallDiameterM, kMaxBallDiameterM]
+  // Beyond the paper, in the labels (not the table): white seen beyond the carpet's outer edge is
+  // the hall, since the lines lie on the carpet; the edge is found in each classified image along
+  // every bearing, without the pose (core::CarpetEdge, ActTrainer::unlabelWhiteBeyondCarpet).
+  bool carpet_edge = true;
 
   void validate() const;
   // Sets the parameter `name` (as the field is named) from text; throws std::invalid_argument for
@@ -249,6 +254,9 @@ class ActTrainer {
   // with this camera and ActParams::ball_diameter_m. Returns the pixels relabelled (0 when the
   // cycle saw no ball).
   uint32_t labelBall(const CycleStats& stats, cv::Mat& labels) const;
+  // ActParams::carpet_edge: white beyond the carpet's edge in these labels (of the camera's size,
+  // as core::Segmenter gives them) labelled unknown; returns how many pixels (0 when off).
+  uint32_t unlabelWhiteBeyondCarpet(cv::Mat& labels) const;
 
  private:
   ClusterParams clusterParams() const;
@@ -500,6 +508,7 @@ class ActTrainer {
   void removeOffField(const Pixels& pixels, const PoseTransform& transform, CycleStats& stats);
   int removal_samples_stride_ = 0;
   uint32_t unclassed_samples_ = 0;  // removal samples of colors no class has, so far
+  CarpetEdge carpet_edge_;          // ActParams::carpet_edge, of model_'s camera
   // Ball training.
   BallDetector ball_detector_;
   std::vector<BallBlob> ball_blobs_;

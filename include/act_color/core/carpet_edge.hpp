@@ -1,0 +1,47 @@
+#pragma once
+
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "act_color/core/omni_camera_model.hpp"
+
+namespace act_color {
+namespace core {
+
+// Beyond the paper (ActParams::carpet_edge): the lines lie on the carpet, so white seen beyond the
+// carpet's outer edge is the hall (a white wall, a shirt, a lamp, a bright floor), whatever the
+// table says of its color. The edge is found in the classified image itself, without the pose:
+// along each of kSectors sectors of bearings, the farthest ground distance (in bins of kBinM) at
+// which at least kMinGreenShare of the imaged pixels (and kMinGreenPixels) are green; a sector's
+// edge is the farthest of its own and its kSpreadSectors neighbours' on either side (a robot or a
+// person standing on the carpet hides it in a few sectors). White farther than the edge plus
+// kMarginM (the outer line and the blur round it, where the carpet ends right behind the line) is
+// labelled unknown. A sector where no green is seen keeps its white: nothing is known there.
+class CarpetEdge {
+ public:
+  explicit CarpetEdge(const OmniCameraModel& camera);
+
+  // labels: CV_8UC1 of the camera's size (class ids), as core::Segmenter gives them. Returns how
+  // many pixels were labelled kUnknown; labels of another size or type are left as they are (0).
+  uint32_t unlabelWhiteBeyond(cv::Mat& labels) const;
+
+  static constexpr int kSectors = 256;
+  static constexpr double kBinM = 0.1;
+  static constexpr int kBins = 255;  // the last bin: above the horizon or farther
+  static constexpr double kMinGreenShare = 0.25;
+  static constexpr uint32_t kMinGreenPixels = 2;
+  static constexpr int kSpreadSectors = 2;
+  static constexpr double kMarginM = 0.3;
+
+ private:
+  static constexpr uint16_t kNoCell = UINT16_MAX;
+  int width_ = 0, height_ = 0;
+  // Per pixel: sector << 8 | bin of its ground distance; kNoCell where nothing is imaged (outside
+  // the mirror, the own chassis and the calibration's self mask).
+  std::vector<uint16_t> cell_;
+  std::vector<uint32_t> pixels_in_cell_;  // imaged pixels per cell
+};
+
+}  // namespace core
+}  // namespace act_color
