@@ -267,6 +267,7 @@ void ActParams::set(const std::string& name, const std::string& value) {
     ball_diameter_m = number();
   } else if (name == "carpet_edge") {
     carpet_edge = boolean();
+
   } else {
     throw std::invalid_argument("unknown ACT parameter '" + name + "'");
   }
@@ -1340,8 +1341,8 @@ constexpr size_t kBallAddsPerCycle = 1024;
 
 }  // namespace
 
-uint32_t ActTrainer::unlabelWhiteBeyondCarpet(cv::Mat& labels) const {
-  return params_.carpet_edge ? carpet_edge_.unlabelWhiteBeyond(labels) : 0;
+uint32_t ActTrainer::unlabelBeyondCarpet(cv::Mat& labels) const {
+  return params_.carpet_edge ? carpet_edge_.unlabelBeyond(labels) : 0;
 }
 
 uint32_t ActTrainer::labelBall(const CycleStats& stats, cv::Mat& labels) const {

@@ -767,7 +767,7 @@ void ActTrainerNodelet::publishOutputs(const core::ImageView& view, const sensor
   }
   if (classified_pub_.getNumSubscribers() > 0) {
     segmenter_->classify(trainer_->lut(), view, labels_);
-    trainer_->unlabelWhiteBeyondCarpet(labels_);
+    trainer_->unlabelBeyondCarpet(labels_);
     if (trained) trainer_->labelBall(*trained, labels_);
     cv_bridge::CvImage out(header, "rgb8");
     core::colorizeLabels(labels_, out.image);

@@ -106,7 +106,8 @@ class SegmentationNodelet : public nodelet::Nodelet {
   std::shared_ptr<const core::Segmenter> segmenter_;
   sensor_msgs::ImageConstPtr pending_self_mask_;  // came while the calibration was loading
   size_t self_mask_pixels_ = 0;                   // of the learned self mask in use
-  // ~carpet_edge: white beyond the carpet's edge labelled unknown (core::CarpetEdge, of camera_).
+  // ~carpet_edge: white and black beyond the carpet's edge labelled unknown (core::CarpetEdge, of
+  // camera_).
   std::shared_ptr<const core::CarpetEdge> carpet_edge_;
   bool carpet_edge_on_ = true;
   uint32_t beyond_carpet_ = 0;  // pixels it labelled unknown in the last image
@@ -517,7 +518,7 @@ double SegmentationNodelet::process(const sensor_msgs::ImageConstPtr& image, con
   const auto start = std::chrono::steady_clock::now();
   if (lut) {
     segmenter->classify(ros_conversions::lutView(*lut), view, labels);  // throws for a wrong size or color space
-    const uint32_t unlabelled = carpet_edge ? carpet_edge->unlabelWhiteBeyond(labels) : 0;
+    const uint32_t unlabelled = carpet_edge ? carpet_edge->unlabelBeyond(labels) : 0;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       beyond_carpet_ = unlabelled;
@@ -644,7 +645,7 @@ void SegmentationNodelet::diagnose(diagnostic_updater::DiagnosticStatusWrapper& 
   }
   status.add("label rate (Hz)", window_.rateHz());
   status.add("own robot's pixels learned by the trainer, labelled black", self_mask_pixels_);
-  status.add("white beyond the carpet's edge labelled unknown (px, last image)", beyond_carpet_);
+  status.add("pixels beyond the carpet's edge labelled unknown (last image)", beyond_carpet_);
   status.add("with the table of the same frame (%, last 5 s)", percent(exact, n));
   status.add("with an older or the newest table (%, last 5 s)", percent(stale, n));
   status.add("without a table, all unknown (%, last 5 s)", percent(none, n));

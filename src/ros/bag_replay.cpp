@@ -311,7 +311,7 @@ ReplayResult replay(const ReplayOptions& options, const core::Calibration& calib
         ++result.without_pose;
       }
       segmenter->classify(trainer.lut(), view, labels);
-      trainer.unlabelWhiteBeyondCarpet(labels);
+      trainer.unlabelBeyondCarpet(labels);
       trainer.labelBall(stats, labels);
       if (hand_over) {
         if (std::optional<core::Calibration> masked = hand_over->next(*self_mask)) {

@@ -236,7 +236,7 @@ SceneResult evaluateScene(const FamilyScene& scene, const std::vector<EvalMode>&
       if (i == 0) trainers[m].bootstrap(view, f.told_pose, std::max(0, options.bootstrap_cycles - 1));
       const core::CycleStats stats = trainers[m].cycle(view, f.told_pose);
       segmenter.classify(trainers[m].lut(), view, labels[m]);
-      trainers[m].unlabelWhiteBeyondCarpet(labels[m]);
+      trainers[m].unlabelBeyondCarpet(labels[m]);
       trainers[m].labelBall(stats, labels[m]);
       evaluations[m].addFrame(labels[m], frame.labels);
       BallFigures& b = result.ball[m];

@@ -214,15 +214,18 @@ RealImageResult evaluateRealImage(const RealImage& image,
             variant == "wrong_pose" && f >= kRealFramesBefore && f < kRealFramesBefore + kRealWrongPoseFrames;
         const core::CycleStats stats = trainer.cycle(view, pose_wrong ? wrong_pose : pose);
         const core::ColorLut& lut = trainer.lut();
-        // The labels as the segmentation gives them: the table's, white beyond the carpet's edge
-        // unknown (ActParams::carpet_edge), and the ball's image where the cycle saw it (below). The
-        // figures read the table, but a white the carpet's edge took out counts as unknown.
+        // The labels as the segmentation gives them: the table's, white and black beyond the
+        // carpet's edge unknown (ActParams::carpet_edge), and the ball's image where the cycle saw
+        // it (below). The figures read the table, but a color the carpet's edge took out counts as
+        // unknown.
         segmenter.classify(lut, view, labels);
-        trainer.unlabelWhiteBeyondCarpet(labels);
+        trainer.unlabelBeyondCarpet(labels);
         auto classOf = [&](int index) {
           const cv::Vec3b c = frame.at<cv::Vec3b>(index / frame.cols, index % frame.cols);
           const uint8_t k = lut.classOf(c[0], c[1], c[2]);
-          return k == core::kWhite && labels.ptr<uint8_t>()[index] == core::kUnknown ? uint8_t{core::kUnknown} : k;
+          const bool taken_out =
+              (k == core::kWhite || k == core::kBlack) && labels.ptr<uint8_t>()[index] == core::kUnknown;
+          return taken_out ? uint8_t{core::kUnknown} : k;
         };
         RealFrameFigures fig;
         if (!whites.empty()) {

@@ -94,7 +94,7 @@ act_color::ColorLutConstPtr trainerCallback(ActTrainer& trainer, const sensor_ms
 
 // The segmentation nodelet's per-image work (src/nodelets/segmentation_nodelet.cpp, process): a
 // view of the message, the labels written straight into a new mono8 message with the shared
-// table (no copy of it), white beyond the carpet's edge unlabelled (~carpet_edge), the ball the
+// table (no copy of it), white and black beyond the carpet's edge unlabelled (~carpet_edge), the ball the
 // trainer saw labelled as its image.
 sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter, const core::CarpetEdge& carpet_edge,
                                                 const core::OmniCameraModel& camera,
@@ -107,7 +107,7 @@ sensor_msgs::ImageConstPtr segmentationCallback(const core::Segmenter& segmenter
   cv::Mat labels;
   sensor_msgs::ImagePtr labels_msg = conv::newLabelsMsg(*image, &labels);
   segmenter.classify(conv::lutView(*lut), v, labels);
-  carpet_edge.unlabelWhiteBeyond(labels);
+  carpet_edge.unlabelBeyond(labels);
   if (ball.seen) core::labelBallImage(camera, 0.11, ball.x_m, ball.y_m, labels);
   return labels_msg;
 }
@@ -286,7 +286,7 @@ SizeResult benchmarkSize(const Calibration& cal, double sample_ms, int samples) 
     cv::Mat work = labels.clone();
     add("carpet_edge", [&] {
       labels.copyTo(work);
-      carpet_edge.unlabelWhiteBeyond(work);
+      carpet_edge.unlabelBeyond(work);
     });
   }
   core::LutView lv{trainer.lut().data(), trainer.lut().size(), trainer.lut().bitsPerChannel(), core::ColorSpace::kRgb};

@@ -1,13 +1,16 @@
 // The segmentation nodelet alone, fed by the test as the ACT trainer would feed it: the ball the
 // trainer saw in an image (/act/ball) is labelled as the ball's image in that image's labels
 // (core::labelBallImage), and in no other image's; an image no table can classify is refused
-// when it comes.
+// when it comes; white beyond the carpet's edge is unknown unless ~carpet_edge is switched off.
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <geometry_msgs/PointStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/Image.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <opencv2/core.hpp>
 #include <string>
@@ -15,6 +18,7 @@
 #include "act_color/ColorLut.h"
 #include "act_color/core/ball_detector.hpp"
 #include "act_color/core/calibration.hpp"
+#include "act_color/core/carpet_edge.hpp"
 #include "act_color/core/omni_camera_model.hpp"
 #include "test_util.hpp"
 
@@ -122,6 +126,89 @@ TEST(Segmentation, RefusesAnImageNoTableCanClassifyOnArrival) {
   ASSERT_TRUE(waiter.waitFor(20.0, [&] { return !refused.isZero(); })) << "no error for the mono16 image";
   std::lock_guard<std::mutex> lock(waiter.mutex());
   EXPECT_LT((refused - sent).toSec(), 2.5) << "refused only after waiting for a table";
+}
+
+TEST(Segmentation, WhiteBeyondTheCarpetIsUnknownUnlessSwitchedOff) {
+  ros::NodeHandle nh, pnh("~");
+  const core::Calibration cal = core::loadCalibration(pnh.param<std::string>("calibration", ""));
+  const core::OmniCameraModel camera(cal.camera);
+  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/omni/image_raw", 10);
+  ros::Publisher lut_pub = nh.advertise<act_color::ColorLut>("/act/color_lut", 10);
+  act_color_test::Waiter waiter;
+  std::map<ros::Time, sensor_msgs::ImageConstPtr> labels;
+  ros::Subscriber labels_sub =
+      nh.subscribe<sensor_msgs::Image>("/segmentation/labels", 10, [&](const sensor_msgs::ImageConstPtr& msg) {
+        std::lock_guard<std::mutex> lock(waiter.mutex());
+        labels[msg->header.stamp] = msg;
+        waiter.notify();
+      });
+  ros::AsyncSpinner spinner(2);
+  spinner.start();
+  ASSERT_TRUE(waiter.waitFor(30.0, [&] {
+    return image_pub.getNumSubscribers() > 0 && lut_pub.getNumSubscribers() > 0 && labels_sub.getNumPublishers() > 0;
+  })) << "the segmentation did not connect";
+  // Carpet to 3 m (a green the table knows), a white hall beyond it and above the horizon.
+  const uint8_t carpet[3] = {20, 140, 20}, hall[3] = {250, 250, 250};
+  act_color::ColorLut lut;
+  lut.color_space = act_color::ColorLut::COLOR_SPACE_RGB;
+  lut.bits_per_channel = 6;
+  lut.table.assign(size_t{1} << 18, core::kUnknown);
+  auto cell = [](const uint8_t c[3]) { return (size_t{c[0]} >> 2) << 12 | (size_t{c[1]} >> 2) << 6 | (c[2] >> 2); };
+  lut.table[cell(carpet)] = core::kGreen;
+  lut.table[cell(hall)] = core::kWhite;
+  sensor_msgs::Image image;
+  image.width = static_cast<uint32_t>(camera.width());
+  image.height = static_cast<uint32_t>(camera.height());
+  image.encoding = "rgb8";
+  image.step = 3 * image.width;
+  image.data.assign(static_cast<size_t>(image.step) * image.height, 0);
+  // The hall, and the part of it farther than the edge's margin (core::CarpetEdge::kMarginM, the
+  // 0.1 m bins rounded) from the carpet: always unknown with ~carpet_edge.
+  int hall_pixels = 0;
+  cv::Mat far_hall(camera.height(), camera.width(), CV_8UC1, cv::Scalar(0));
+  for (int v = 0; v < camera.height(); ++v) {
+    for (int u = 0; u < camera.width(); ++u) {
+      const core::PixelRay& ray = camera.ray(u, v);
+      if (ray.region != core::PixelRegion::kFloor && ray.region != core::PixelRegion::kAboveHorizon) continue;
+      const bool on_carpet =
+          ray.region == core::PixelRegion::kFloor && std::hypot(ray.ground_x_m, ray.ground_y_m) < 3.0;
+      hall_pixels += !on_carpet;
+      far_hall.at<uint8_t>(v, u) = ray.region == core::PixelRegion::kAboveHorizon ||
+                                   std::hypot(ray.ground_x_m, ray.ground_y_m) >= 3.0 + core::CarpetEdge::kMarginM + 0.2;
+      std::copy(on_carpet ? carpet : hall, (on_carpet ? carpet : hall) + 3, &image.data[image.step * v + 3 * u]);
+    }
+  }
+  ASSERT_GT(hall_pixels, 1000);
+  auto carpetEdge = [&](bool on) {
+    dynamic_reconfigure::Reconfigure srv;
+    dynamic_reconfigure::BoolParameter p;
+    p.name = "carpet_edge";
+    p.value = on;
+    srv.request.config.bools.push_back(p);
+    EXPECT_TRUE(ros::service::call("/segmentation/set_parameters", srv));
+  };
+  // White pixels in the labels of an image with this stamp; `far`: only those of far_hall.
+  auto whiteIn = [&](const ros::Time& stamp, bool far) {
+    lut.header.stamp = stamp;
+    ++lut.revision;
+    lut_pub.publish(lut);
+    image.header.stamp = stamp;
+    image_pub.publish(image);
+    EXPECT_TRUE(waiter.waitFor(30.0, [&] { return labels.count(stamp) > 0; })) << "no labels at " << stamp;
+    std::lock_guard<std::mutex> lock(waiter.mutex());
+    if (!labels.count(stamp)) return -1;
+    const sensor_msgs::Image& m = *labels.at(stamp);
+    const cv::Mat l(m.height, m.width, CV_8UC1, const_cast<uint8_t*>(m.data.data()), m.step);
+    return cv::countNonZero(far ? (l == core::kWhite) & far_hall : l == core::kWhite);
+  };
+  const int far_pixels = cv::countNonZero(far_hall);
+  ASSERT_GT(far_pixels, hall_pixels / 2);
+  EXPECT_EQ(whiteIn(ros::Time(3000, 0), true), 0);
+  carpetEdge(false);
+  EXPECT_EQ(whiteIn(ros::Time(3000, 100000000), false), hall_pixels);
+  carpetEdge(true);
+  EXPECT_EQ(whiteIn(ros::Time(3000, 200000000), true), 0);
+  EXPECT_LT(whiteIn(ros::Time(3000, 300000000), false), hall_pixels - far_pixels + 1);
 }
 
 }  // namespace

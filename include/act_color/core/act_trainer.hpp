@@ -119,8 +119,9 @@ struct ActParams {
   bool ball_training = true;
   double ball_diameter_m = 0.22;  // in [kMinBallDiameterM, kMaxBallDiameterM]
   // Beyond the paper, in the labels (not the table): white seen beyond the carpet's outer edge is
-  // the hall, since the lines lie on the carpet; the edge is found in each classified image along
-  // every bearing, without the pose (core::CarpetEdge, ActTrainer::unlabelWhiteBeyondCarpet).
+  // the hall, since the lines lie on the carpet, and so is black there unless a robot stands on
+  // the carpet in that direction; the edge is found in each classified image along every bearing,
+  // without the pose (core::CarpetEdge, ActTrainer::unlabelBeyondCarpet).
   bool carpet_edge = true;
 
   void validate() const;
@@ -255,8 +256,9 @@ class ActTrainer {
   // cycle saw no ball).
   uint32_t labelBall(const CycleStats& stats, cv::Mat& labels) const;
   // ActParams::carpet_edge: white beyond the carpet's edge in these labels (of the camera's size,
-  // as core::Segmenter gives them) labelled unknown; returns how many pixels (0 when off).
-  uint32_t unlabelWhiteBeyondCarpet(cv::Mat& labels) const;
+  // as core::Segmenter gives them), and black there where no robot stands on the carpet, labelled
+  // unknown (core::CarpetEdge::unlabelBeyond); returns how many pixels (0 when off).
+  uint32_t unlabelBeyondCarpet(cv::Mat& labels) const;
 
  private:
   ClusterParams clusterParams() const;
