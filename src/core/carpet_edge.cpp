@@ -9,11 +9,10 @@ namespace act_color {
 namespace core {
 
 CarpetEdge::CarpetEdge(const OmniCameraModel& camera)
-    : width_(camera.width()),
-      height_(camera.height()),
-      cell_(static_cast<size_t>(camera.width()) * camera.height(), kNoCell),
-      pixels_in_cell_(kSectors << 8, 0) {
-  for (size_t i = 0; i < cell_.size(); ++i) {
+    : width_(camera.width()), height_(camera.height()), cell_start_(kCells + 1, 0) {
+  const size_t n = static_cast<size_t>(width_) * height_;
+  std::vector<int> cell(n, -1);
+  for (size_t i = 0; i < n; ++i) {
     const PixelRay& ray = camera.ray(i);
     if (ray.region != PixelRegion::kFloor && ray.region != PixelRegion::kAboveHorizon) continue;
     double turns = ray.bearing_rad / (2 * M_PI);
@@ -23,64 +22,76 @@ CarpetEdge::CarpetEdge(const OmniCameraModel& camera)
     if (ray.region == PixelRegion::kFloor) {
       bin = std::min(kBins, static_cast<int>(std::hypot(ray.ground_x_m, ray.ground_y_m) / kBinM));
     }
-    cell_[i] = static_cast<uint16_t>(sector << 8 | bin);
-    ++pixels_in_cell_[cell_[i]];
+    cell[i] = sector << 8 | bin;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    if (cell[i] >= 0) ++cell_start_[cell[i] + 1];
+  }
+  for (int c = 0; c < kCells; ++c) cell_start_[c + 1] += cell_start_[c];
+  pixels_.resize(cell_start_[kCells]);
+  std::vector<uint32_t> next(cell_start_.begin(), cell_start_.end() - 1);
+  for (size_t i = 0; i < n; ++i) {
+    if (cell[i] >= 0) pixels_[next[cell[i]]++] = static_cast<uint32_t>(i);
   }
 }
 
 uint32_t CarpetEdge::unlabelBeyond(cv::Mat& labels) const {
   if (labels.type() != CV_8UC1 || labels.cols != width_ || labels.rows != height_ || !labels.isContinuous()) return 0;
   uint8_t* l = labels.ptr<uint8_t>();
-  const size_t n = cell_.size();
-  // Per cell the green pixels; per sector the nearest bin labelled black.
-  std::vector<uint32_t> green(kSectors << 8, 0);
-  std::vector<int> nearest_black(kSectors, kBins + 1);
-  for (size_t i = 0; i < n; ++i) {
-    if (cell_[i] == kNoCell) continue;
-    if (l[i] == kGreen) {
-      ++green[cell_[i]];
-    } else if (l[i] == kBlack) {
-      int& b = nearest_black[cell_[i] >> 8];
-      b = std::min(b, cell_[i] & 0xff);
-    }
-  }
-  // The carpet's edge in each sector: its farthest bin with enough green.
+  const uint32_t* const px = pixels_.data();
+  auto begin = [&](int s, int b) { return px + cell_start_[s << 8 | b]; };
+  auto end = [&](int s, int b) { return px + cell_start_[(s << 8 | b) + 1]; };
+  // The carpet's edge in each sector: its farthest bin with enough green, found from the hall
+  // inwards.
   std::vector<int> edge(kSectors, -1);
   for (int s = 0; s < kSectors; ++s) {
-    for (int b = kBins - 1; b >= 0; --b) {
-      const uint32_t g = green[s << 8 | b];
-      if (g >= kMinGreenPixels && g >= kMinGreenShare * pixels_in_cell_[s << 8 | b]) {
-        edge[s] = b;
-        break;
-      }
+    for (int b = kBins - 1; b >= 0 && edge[s] < 0; --b) {
+      uint32_t green = 0;
+      for (const uint32_t* p = begin(s, b); p != end(s, b); ++p) green += l[*p] == kGreen;
+      const auto imaged = static_cast<uint32_t>(end(s, b) - begin(s, b));
+      if (green >= kMinGreenPixels && green >= kMinGreenShare * imaged) edge[s] = b;
     }
   }
   // Beyond `limit`: the farthest edge of the sector and its neighbours, plus the margin. A sector
   // with no green anywhere near keeps everything (nothing is known there).
-  auto neighbours = [](int s, int k) { return (s + k + kSectors) % kSectors; };
+  auto neighbour = [](int s, int k) { return (s + k + kSectors) % kSectors; };
   const int margin = static_cast<int>(std::ceil(kMarginM / kBinM));
   std::vector<int> limit(kSectors);
   for (int s = 0; s < kSectors; ++s) {
     int e = -1;
-    for (int k = -kSpreadSectors; k <= kSpreadSectors; ++k) e = std::max(e, edge[neighbours(s, k)]);
+    for (int k = -kSpreadSectors; k <= kSpreadSectors; ++k) e = std::max(e, edge[neighbour(s, k)]);
     limit[s] = e < 0 ? kBins : e + margin;
   }
-  // A robot stands in a sector when black lies within its limit there or in a neighbour.
-  std::vector<uint8_t> robot(kSectors, 0);
-  for (int s = 0; s < kSectors; ++s) {
-    for (int k = -kSpreadSectors; k <= kSpreadSectors; ++k) {
-      const int t = neighbours(s, k);
-      robot[s] = robot[s] || nearest_black[t] <= limit[t];
+  // A robot stands in a sector when black lies within the limit there or in a neighbour; looked at
+  // only for sectors with black beyond their limit, from the limit inwards (a robot's body crosses
+  // the edge). Nothing within a limit is changed below.
+  std::vector<int8_t> black_within(kSectors, -1);
+  auto blackWithin = [&](int t) {
+    if (black_within[t] < 0) {
+      black_within[t] = 0;
+      for (int b = std::min(limit[t], kBins); b >= 0 && !black_within[t]; --b) {
+        for (const uint32_t* p = begin(t, b); p != end(t, b) && !black_within[t]; ++p) {
+          black_within[t] = l[*p] == kBlack;
+        }
+      }
     }
-  }
+    return black_within[t] == 1;
+  };
   uint32_t unlabelled = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (cell_[i] == kNoCell) continue;
-    const int s = cell_[i] >> 8;
-    if ((cell_[i] & 0xff) <= limit[s]) continue;
-    if (l[i] == kWhite || (l[i] == kBlack && !robot[s])) {
-      l[i] = kUnknown;
-      ++unlabelled;
+  for (int s = 0; s < kSectors; ++s) {
+    int robot = -1;  // unknown yet
+    for (int b = limit[s] + 1; b <= kBins; ++b) {
+      for (const uint32_t* p = begin(s, b); p != end(s, b); ++p) {
+        uint8_t& k = l[*p];
+        if (k == kBlack && robot < 0) {
+          robot = 0;
+          for (int i = -kSpreadSectors; i <= kSpreadSectors && !robot; ++i) robot = blackWithin(neighbour(s, i));
+        }
+        if (k == kWhite || (k == kBlack && !robot)) {
+          k = kUnknown;
+          ++unlabelled;
+        }
+      }
     }
   }
   return unlabelled;

@@ -3,11 +3,18 @@
 // white on the carpet stays, however the carpet ends, and so do the robots' bodies.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <vector>
 
+#include "act_color/core/act_trainer.hpp"
 #include "act_color/core/carpet_edge.hpp"
 #include "act_color/core/omni_camera_model.hpp"
+#include "act_color/core/segmenter.hpp"
 #include "act_color/core/types.hpp"
+#include "act_color/sim/renderer.hpp"
+#include "act_color/sim/scene_family.hpp"
 #include "test_util.hpp"
 
 namespace act_color {
@@ -78,6 +85,57 @@ Scene makeScene(const core::OmniCameraModel& camera) {
   return s;
 }
 
+// The rule as CarpetEdge states it, pixel by pixel over the whole image (CarpetEdge reads only the
+// cells from the hall to the edge and beyond): the reference its outputs must equal.
+uint32_t referenceUnlabelBeyond(const core::OmniCameraModel& camera, cv::Mat& labels) {
+  using E = core::CarpetEdge;
+  const size_t n = labels.total();
+  std::vector<int> cell(n, -1);
+  std::vector<uint32_t> imaged(E::kSectors * 256, 0), green(E::kSectors * 256, 0);
+  std::vector<int> nearest_black(E::kSectors, 1 << 20);
+  uint8_t* l = labels.ptr<uint8_t>();
+  for (size_t i = 0; i < n; ++i) {
+    const core::PixelRay& ray = camera.ray(i);
+    if (ray.region != core::PixelRegion::kFloor && ray.region != core::PixelRegion::kAboveHorizon) continue;
+    double turns = ray.bearing_rad / (2 * M_PI);
+    turns -= std::floor(turns);
+    const int s = std::min(E::kSectors - 1, static_cast<int>(turns * E::kSectors));
+    const int b = ray.region == core::PixelRegion::kFloor
+                      ? std::min(E::kBins, static_cast<int>(std::hypot(ray.ground_x_m, ray.ground_y_m) / E::kBinM))
+                      : E::kBins;
+    cell[i] = s * 256 + b;
+    ++imaged[cell[i]];
+    green[cell[i]] += l[i] == core::kGreen;
+    if (l[i] == core::kBlack) nearest_black[s] = std::min(nearest_black[s], b);
+  }
+  std::vector<int> edge(E::kSectors, -1), limit(E::kSectors);
+  for (int s = 0; s < E::kSectors; ++s) {
+    for (int b = 0; b < E::kBins; ++b) {
+      const uint32_t g = green[s * 256 + b];
+      if (g >= E::kMinGreenPixels && g >= E::kMinGreenShare * imaged[s * 256 + b]) edge[s] = b;
+    }
+  }
+  auto at = [](int s, int k) { return (s + k + E::kSectors) % E::kSectors; };
+  for (int s = 0; s < E::kSectors; ++s) {
+    int e = -1;
+    for (int k = -E::kSpreadSectors; k <= E::kSpreadSectors; ++k) e = std::max(e, edge[at(s, k)]);
+    limit[s] = e < 0 ? E::kBins : e + static_cast<int>(std::ceil(E::kMarginM / E::kBinM));
+  }
+  uint32_t unlabelled = 0;
+  for (size_t i = 0; i < n; ++i) {
+    if (cell[i] < 0) continue;
+    const int s = cell[i] / 256, b = cell[i] % 256;
+    if (b <= limit[s]) continue;
+    bool robot = false;
+    for (int k = -E::kSpreadSectors; k <= E::kSpreadSectors; ++k) robot |= nearest_black[at(s, k)] <= limit[at(s, k)];
+    if (l[i] == core::kWhite || (l[i] == core::kBlack && !robot)) {
+      l[i] = core::kUnknown;
+      ++unlabelled;
+    }
+  }
+  return unlabelled;
+}
+
 TEST(CarpetEdge, HallWhiteAndBlackGoLinesAndRobotsStay) {
   const core::OmniCameraModel camera(test::defaultCalibration().camera);
   const core::CarpetEdge edge(camera);
@@ -89,13 +147,46 @@ TEST(CarpetEdge, HallWhiteAndBlackGoLinesAndRobotsStay) {
   ASSERT_GT(cv::countNonZero(black_hall), 100);
   ASSERT_GT(cv::countNonZero(black_kept), 100);
   const cv::Mat before = s.labels.clone();
+  cv::Mat reference = s.labels.clone();
   const uint32_t unlabelled = edge.unlabelBeyond(s.labels);
   EXPECT_EQ(unlabelled, static_cast<uint32_t>(hall));
+  EXPECT_EQ(referenceUnlabelBeyond(camera, reference), unlabelled);
+  EXPECT_EQ(cv::countNonZero(reference != s.labels), 0);
   EXPECT_EQ(cv::countNonZero((s.labels == before) & (s.keep != 0)), kept);
   EXPECT_EQ(cv::countNonZero((s.labels == core::kUnknown) & (s.hall != 0)), hall);
   // Nothing but white and black is touched, and they only become unknown.
   EXPECT_EQ(cv::countNonZero((s.labels != before) & (before != core::kWhite) & (before != core::kBlack)), 0);
   EXPECT_EQ(cv::countNonZero((s.labels != before) & (s.labels != core::kUnknown)), 0);
+}
+
+TEST(CarpetEdge, AsTheRuleSaysOnScenesOfTheFamilyAndOnNoise) {
+  // Labels as ACT gives them on the first frame of tuning scenes 0-3 (their own cameras), and labels
+  // of random classes in random blobs: equal to the reference pixel for pixel.
+  for (uint32_t seed = sim::kTuningSeedsBegin; seed < sim::kTuningSeedsBegin + 4; ++seed) {
+    const sim::FamilyScene scene = sim::makeFamilyScene(seed);
+    const sim::LabeledFrame frame =
+        sim::Renderer(scene.calibration, scene.renderer).render(scene.scenario.frames.front().scene);
+    const auto view = core::ImageView::fromMat(frame.rgb, core::PixelFormat::kRgb8);
+    core::ActTrainer trainer(scene.calibration);
+    trainer.bootstrap(view, scene.scenario.frames.front().told_pose, 30);
+    cv::Mat labels;
+    core::Segmenter(scene.calibration.camera).classify(trainer.lut(), view, labels);
+    const core::OmniCameraModel camera(scene.calibration.camera);
+    const core::CarpetEdge edge(camera);
+    std::vector<cv::Mat> cases = {labels, frame.labels.clone()};
+    cv::RNG rng(seed);
+    cv::Mat noise(labels.size(), CV_8UC1);
+    rng.fill(noise, cv::RNG::UNIFORM, 0, 8);
+    cv::resize(noise, noise, labels.size() / 8, 0, 0, cv::INTER_NEAREST);
+    cv::resize(noise, noise, labels.size(), 0, 0, cv::INTER_NEAREST);
+    cases.push_back(noise);
+    for (cv::Mat& c : cases) {
+      cv::Mat reference = c.clone();
+      const uint32_t expected = referenceUnlabelBeyond(camera, reference);
+      EXPECT_EQ(edge.unlabelBeyond(c), expected) << "seed " << seed;
+      EXPECT_EQ(cv::countNonZero(reference != c), 0) << "seed " << seed;
+    }
+  }
 }
 
 TEST(CarpetEdge, NoGreenNothingKnownNothingChanged) {

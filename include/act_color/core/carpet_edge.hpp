@@ -31,7 +31,7 @@ class CarpetEdge {
 
   static constexpr int kSectors = 256;
   static constexpr double kBinM = 0.1;
-  // The last bin, kBins: above the horizon or farther (sector 255 and bin 255 would be kNoCell).
+  // The last bin, kBins: above the horizon or farther than the bins before it.
   static constexpr int kBins = 254;
   static constexpr double kMinGreenShare = 0.25;
   static constexpr uint32_t kMinGreenPixels = 2;
@@ -39,12 +39,14 @@ class CarpetEdge {
   static constexpr double kMarginM = 0.3;
 
  private:
-  static constexpr uint16_t kNoCell = UINT16_MAX;
+  static constexpr int kCells = kSectors << 8;  // sector << 8 | bin
   int width_ = 0, height_ = 0;
-  // Per pixel: sector << 8 | bin of its ground distance; kNoCell where nothing is imaged (outside
-  // the mirror, the own chassis and the calibration's self mask).
-  std::vector<uint16_t> cell_;
-  std::vector<uint32_t> pixels_in_cell_;  // imaged pixels per cell
+  // The imaged pixels (not outside the mirror, the own chassis or the calibration's self mask) by
+  // cell: those of cell c are pixels_[cell_start_[c] .. cell_start_[c + 1]). A frame reads the
+  // cells from the hall inwards to the edge, and beyond it, not the whole image (runs along the
+  // rows instead of pixels took twice as long: a cell is a pixel or two wide).
+  std::vector<uint32_t> cell_start_;
+  std::vector<uint32_t> pixels_;
 };
 
 }  // namespace core
