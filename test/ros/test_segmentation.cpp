@@ -14,6 +14,7 @@
 #include <map>
 #include <opencv2/core.hpp>
 #include <string>
+#include <tuple>
 
 #include "act_color/ColorLut.h"
 #include "act_color/core/ball_detector.hpp"
@@ -26,39 +27,62 @@ namespace {
 
 namespace core = act_color::core;
 
-TEST(Segmentation, LabelsTheBallTheTrainerSaw) {
-  ros::NodeHandle nh, pnh("~");
+// The test's side of the segmentation nodelet, as the trainer and a listener would be: the inputs
+// it is fed and the labels it publishes, by stamp.
+struct SegmentationFeed {
+  ros::NodeHandle nh, pnh{"~"};
   const core::Calibration cal = core::loadCalibration(pnh.param<std::string>("calibration", ""));
-  const core::OmniCameraModel camera(cal.camera);
+  const core::OmniCameraModel camera{cal.camera};
   ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/omni/image_raw", 10);
   ros::Publisher lut_pub = nh.advertise<act_color::ColorLut>("/act/color_lut", 10);
   ros::Publisher ball_pub = nh.advertise<geometry_msgs::PointStamped>("/act/ball", 10);
   act_color_test::Waiter waiter;
-  std::map<ros::Time, sensor_msgs::ImageConstPtr> labels;
+  std::map<ros::Time, sensor_msgs::ImageConstPtr> labels;  // under waiter.mutex()
   ros::Subscriber labels_sub =
-      nh.subscribe<sensor_msgs::Image>("/segmentation/labels", 10, [&](const sensor_msgs::ImageConstPtr& msg) {
+      nh.subscribe<sensor_msgs::Image>("/segmentation/labels", 10, [this](const sensor_msgs::ImageConstPtr& msg) {
         std::lock_guard<std::mutex> lock(waiter.mutex());
         labels[msg->header.stamp] = msg;
         waiter.notify();
       });
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  ASSERT_TRUE(waiter.waitFor(30.0, [&] {
-    return image_pub.getNumSubscribers() > 0 && lut_pub.getNumSubscribers() > 0 && ball_pub.getNumSubscribers() > 0 &&
-           labels_sub.getNumPublishers() > 0;
-  })) << "the segmentation did not connect";
+  ros::AsyncSpinner spinner{2};
 
+  SegmentationFeed() { spinner.start(); }
+  bool connected() {
+    return waiter.waitFor(30.0, [&] {
+      return image_pub.getNumSubscribers() > 0 && lut_pub.getNumSubscribers() > 0 && ball_pub.getNumSubscribers() > 0 &&
+             labels_sub.getNumPublishers() > 0;
+    });
+  }
+  // A table of 6 bits per channel in RGB that knows no color.
+  static act_color::ColorLut emptyTable() {
+    act_color::ColorLut lut;
+    lut.color_space = act_color::ColorLut::COLOR_SPACE_RGB;
+    lut.bits_per_channel = 6;
+    lut.table.assign(size_t{1} << 18, core::kUnknown);
+    return lut;
+  }
+  // An rgb8 image of the camera's size, every pixel `grey`.
+  sensor_msgs::Image image(uint8_t grey) const {
+    sensor_msgs::Image m;
+    m.width = static_cast<uint32_t>(camera.width());
+    m.height = static_cast<uint32_t>(camera.height());
+    m.encoding = "rgb8";
+    m.step = 3 * m.width;
+    m.data.assign(static_cast<size_t>(m.step) * m.height, grey);
+    return m;
+  }
+};
+
+TEST(Segmentation, LabelsTheBallTheTrainerSaw) {
+  SegmentationFeed feed;
+  ASSERT_TRUE(feed.connected()) << "the segmentation did not connect";
+  const core::OmniCameraModel& camera = feed.camera;
+  ros::Publisher &image_pub = feed.image_pub, &lut_pub = feed.lut_pub, &ball_pub = feed.ball_pub;
+  act_color_test::Waiter& waiter = feed.waiter;
+  auto& labels = feed.labels;
   // A table that knows no color: every label is unknown but the ball's image.
-  act_color::ColorLut lut;
-  lut.color_space = act_color::ColorLut::COLOR_SPACE_RGB;
-  lut.bits_per_channel = 6;
-  lut.table.assign(size_t{1} << 18, core::kUnknown);
-  sensor_msgs::Image image;
-  image.width = static_cast<uint32_t>(camera.width());
-  image.height = static_cast<uint32_t>(camera.height());
-  image.encoding = "rgb8";
-  image.step = 3 * image.width;
-  image.data.assign(static_cast<size_t>(image.step) * image.height, 128);
+  act_color::ColorLut lut = SegmentationFeed::emptyTable();
+  sensor_msgs::Image image = feed.image(128);
   const double ball_x = 1.0, ball_y = 0.4;  // base_link, m
   const ros::Time seen(1000, 0), unseen(1000, 100000000);
   for (const ros::Time& stamp : {seen, unseen}) {
@@ -129,39 +153,19 @@ TEST(Segmentation, RefusesAnImageNoTableCanClassifyOnArrival) {
 }
 
 TEST(Segmentation, WhiteBeyondTheCarpetIsUnknownUnlessSwitchedOff) {
-  ros::NodeHandle nh, pnh("~");
-  const core::Calibration cal = core::loadCalibration(pnh.param<std::string>("calibration", ""));
-  const core::OmniCameraModel camera(cal.camera);
-  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("/omni/image_raw", 10);
-  ros::Publisher lut_pub = nh.advertise<act_color::ColorLut>("/act/color_lut", 10);
-  act_color_test::Waiter waiter;
-  std::map<ros::Time, sensor_msgs::ImageConstPtr> labels;
-  ros::Subscriber labels_sub =
-      nh.subscribe<sensor_msgs::Image>("/segmentation/labels", 10, [&](const sensor_msgs::ImageConstPtr& msg) {
-        std::lock_guard<std::mutex> lock(waiter.mutex());
-        labels[msg->header.stamp] = msg;
-        waiter.notify();
-      });
-  ros::AsyncSpinner spinner(2);
-  spinner.start();
-  ASSERT_TRUE(waiter.waitFor(30.0, [&] {
-    return image_pub.getNumSubscribers() > 0 && lut_pub.getNumSubscribers() > 0 && labels_sub.getNumPublishers() > 0;
-  })) << "the segmentation did not connect";
+  SegmentationFeed feed;
+  ASSERT_TRUE(feed.connected()) << "the segmentation did not connect";
+  const core::OmniCameraModel& camera = feed.camera;
+  ros::Publisher &image_pub = feed.image_pub, &lut_pub = feed.lut_pub;
+  act_color_test::Waiter& waiter = feed.waiter;
+  auto& labels = feed.labels;
   // Carpet to 3 m (a green the table knows), a white hall beyond it and above the horizon.
   const uint8_t carpet[3] = {20, 140, 20}, hall[3] = {250, 250, 250};
-  act_color::ColorLut lut;
-  lut.color_space = act_color::ColorLut::COLOR_SPACE_RGB;
-  lut.bits_per_channel = 6;
-  lut.table.assign(size_t{1} << 18, core::kUnknown);
+  act_color::ColorLut lut = SegmentationFeed::emptyTable();
   auto cell = [](const uint8_t c[3]) { return (size_t{c[0]} >> 2) << 12 | (size_t{c[1]} >> 2) << 6 | (c[2] >> 2); };
   lut.table[cell(carpet)] = core::kGreen;
   lut.table[cell(hall)] = core::kWhite;
-  sensor_msgs::Image image;
-  image.width = static_cast<uint32_t>(camera.width());
-  image.height = static_cast<uint32_t>(camera.height());
-  image.encoding = "rgb8";
-  image.step = 3 * image.width;
-  image.data.assign(static_cast<size_t>(image.step) * image.height, 0);
+  sensor_msgs::Image image = feed.image(0);
   // The hall, and the part of it farther than the edge's margin (core::CarpetEdge::kMarginM, the
   // 0.1 m bins rounded) from the carpet: always unknown with ~carpet_edge.
   int hall_pixels = 0;
