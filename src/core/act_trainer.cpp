@@ -267,7 +267,6 @@ void ActParams::set(const std::string& name, const std::string& value) {
     ball_diameter_m = number();
   } else if (name == "carpet_edge") {
     carpet_edge = boolean();
-
   } else {
     throw std::invalid_argument("unknown ACT parameter '" + name + "'");
   }
