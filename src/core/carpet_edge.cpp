@@ -1,6 +1,7 @@
 #include "act_color/core/carpet_edge.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "act_color/core/types.hpp"
@@ -43,7 +44,8 @@ uint32_t CarpetEdge::unlabelBeyond(cv::Mat& labels) const {
   auto end = [&](int s, int b) { return px + cell_start_[(s << 8 | b) + 1]; };
   // The carpet's edge in each sector: its farthest bin with enough green, found from the hall
   // inwards.
-  std::vector<int> edge(kSectors, -1);
+  std::array<int, kSectors> edge;
+  edge.fill(-1);
   for (int s = 0; s < kSectors; ++s) {
     for (int b = kBins - 1; b >= 0 && edge[s] < 0; --b) {
       uint32_t green = 0;
@@ -56,7 +58,7 @@ uint32_t CarpetEdge::unlabelBeyond(cv::Mat& labels) const {
   // with no green anywhere near keeps everything (nothing is known there).
   auto neighbour = [](int s, int k) { return (s + k + kSectors) % kSectors; };
   const int margin = static_cast<int>(std::ceil(kMarginM / kBinM));
-  std::vector<int> limit(kSectors);
+  std::array<int, kSectors> limit;
   for (int s = 0; s < kSectors; ++s) {
     int e = -1;
     for (int k = -kSpreadSectors; k <= kSpreadSectors; ++k) e = std::max(e, edge[neighbour(s, k)]);
@@ -65,7 +67,8 @@ uint32_t CarpetEdge::unlabelBeyond(cv::Mat& labels) const {
   // A robot stands in a sector when black lies within the limit there or in a neighbour; looked at
   // only for sectors with black beyond their limit, from the limit inwards (a robot's body crosses
   // the edge). Nothing within a limit is changed below.
-  std::vector<int8_t> black_within(kSectors, -1);
+  std::array<int8_t, kSectors> black_within;
+  black_within.fill(-1);
   auto blackWithin = [&](int t) {
     if (black_within[t] < 0) {
       black_within[t] = 0;

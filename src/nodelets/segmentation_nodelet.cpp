@@ -75,8 +75,17 @@ class SegmentationNodelet : public nodelet::Nodelet {
   // mono8 of the camera's size, nonzero = own robot), labelled black from then on as the
   // calibration's self mask is. Kept until the calibration is loaded when it comes before.
   void onSelfMask(const sensor_msgs::ImageConstPtr& msg);
-  // With the lock held: a segmenter with that mask; false (and why) when it does not fit the camera.
-  bool useSelfMask(const sensor_msgs::Image& msg, std::string* error);
+  // The segmenter and the carpet's edge of `camera` with that mask (building them takes some 10 ms
+  // at 640x480: done without the lock); false (and why) when it does not fit the camera.
+  struct Masked {
+    std::shared_ptr<const core::Segmenter> segmenter;
+    std::shared_ptr<const core::CarpetEdge> carpet_edge;
+    size_t pixels = 0;
+  };
+  static bool withSelfMask(core::CameraCalibration camera, const sensor_msgs::Image& msg, Masked* masked,
+                           std::string* error);
+  // With the lock held: takes them into use.
+  void useSelfMask(Masked masked);
   void flush();
   // The classify time in ms. `ball`: the trainer's sighting in this image, labelled as the ball's
   // image (core::labelBallImage).
@@ -227,8 +236,13 @@ void SegmentationNodelet::loadCalibration() {
     field_ = calibration.field;
     lazy = lazy_;
     std::string error;
-    if (pending_self_mask_ && !useSelfMask(*pending_self_mask_, &error)) {
-      NODELET_ERROR("the trainer's self mask is not used: %s", error.c_str());
+    Masked masked;
+    if (pending_self_mask_) {
+      if (withSelfMask(camera_->calibration(), *pending_self_mask_, &masked, &error)) {
+        useSelfMask(std::move(masked));
+      } else {
+        NODELET_ERROR("the trainer's self mask is not used: %s", error.c_str());
+      }
     }
     pending_self_mask_.reset();
   }
@@ -347,22 +361,31 @@ void SegmentationNodelet::onImage(const sensor_msgs::ImageConstPtr& msg) {
 }
 
 void SegmentationNodelet::onSelfMask(const sensor_msgs::ImageConstPtr& msg) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!segmenter_) {
-    if (loading()) pending_self_mask_ = msg;
-    return;
+  core::CameraCalibration camera;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!segmenter_) {
+      if (loading()) pending_self_mask_ = msg;
+      return;
+    }
+    camera = camera_->calibration();
   }
   std::string error;
-  if (useSelfMask(*msg, &error)) {
-    NODELET_INFO("the own robot's pixels learned by the trainer (%zu px) are labelled black from now on",
-                 self_mask_pixels_);
-  } else {
+  Masked masked;
+  if (!withSelfMask(std::move(camera), *msg, &masked, &error)) {
     ACT_WALL_THROTTLE(5.0, NODELET_ERROR("the trainer's self mask is not used: %s", error.c_str()));
+    return;
   }
+  const size_t pixels = masked.pixels;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    useSelfMask(std::move(masked));
+  }
+  NODELET_INFO("the own robot's pixels learned by the trainer (%zu px) are labelled black from now on", pixels);
 }
 
-bool SegmentationNodelet::useSelfMask(const sensor_msgs::Image& msg, std::string* error) {
-  core::CameraCalibration camera = camera_->calibration();
+bool SegmentationNodelet::withSelfMask(core::CameraCalibration camera, const sensor_msgs::Image& msg, Masked* masked,
+                                       std::string* error) {
   if (msg.encoding != "mono8") {
     *error = "encoding '" + msg.encoding + "', not mono8";
     return false;
@@ -377,12 +400,17 @@ bool SegmentationNodelet::useSelfMask(const sensor_msgs::Image& msg, std::string
   // The calibration's own mask stays part of it (the trainer sends the two together).
   core::addSelfMask(camera, msg.data.data(), camera.width, camera.height, msg.step);
   camera.self_mask_file.clear();
-  segmenter_ = std::make_shared<const core::Segmenter>(camera);
-  // Its pixels are the own robot's, not the hall's or the carpet's: out of the carpet's edge too
-  // (some 10 ms at 640x480, once per mask).
-  carpet_edge_ = std::make_shared<const core::CarpetEdge>(core::OmniCameraModel(camera));
-  self_mask_pixels_ = static_cast<size_t>(std::count(camera.self_mask.begin(), camera.self_mask.end(), 1));
+  masked->segmenter = std::make_shared<const core::Segmenter>(camera);
+  // Its pixels are the own robot's, not the hall's or the carpet's: out of the carpet's edge too.
+  masked->carpet_edge = std::make_shared<const core::CarpetEdge>(core::OmniCameraModel(camera));
+  masked->pixels = static_cast<size_t>(std::count(camera.self_mask.begin(), camera.self_mask.end(), 1));
   return true;
+}
+
+void SegmentationNodelet::useSelfMask(Masked masked) {
+  segmenter_ = std::move(masked.segmenter);
+  carpet_edge_ = std::move(masked.carpet_edge);
+  self_mask_pixels_ = masked.pixels;
 }
 
 void SegmentationNodelet::onTable(const act_color::ColorLutConstPtr& msg) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "act_color/core/act_trainer.hpp"
+#include "act_color/core/metrics.hpp"
 #include "act_color/core/segmenter.hpp"
 #include "act_color/core/types.hpp"
 #include "act_color/sim/renderer.hpp"
@@ -15,19 +16,6 @@
 
 namespace act_color {
 namespace {
-
-struct Counts {
-  uint8_t k = core::kWhite;
-  double truth = 0, hits = 0, predicted = 0;
-  double recall() const { return hits / truth; }
-  double precision() const { return predicted > 0 ? hits / predicted : 0.0; }
-  void add(const cv::Mat& labels, const cv::Mat& truth_labels) {
-    const cv::Mat predicted_k = (labels == k) & (truth_labels != core::kNotImaged);
-    truth += cv::countNonZero(truth_labels == k);
-    predicted += cv::countNonZero(predicted_k);
-    hits += cv::countNonZero(predicted_k & (truth_labels == k));
-  }
-};
 
 TEST(CarpetEdgeOnTheFamily, HallWhiteAndBlackGoTheLinesAndRobotsStay) {
   std::array<double, 2> precision_gain{};
@@ -37,7 +25,7 @@ TEST(CarpetEdgeOnTheFamily, HallWhiteAndBlackGoTheLinesAndRobotsStay) {
     const core::Segmenter segmenter(scene.calibration.camera);
     core::ActTrainer trainer(scene.calibration);
     ASSERT_TRUE(trainer.params().carpet_edge);
-    std::array<Counts, 2> table{Counts{core::kWhite}, Counts{core::kBlack}}, edge = table;
+    core::ClassificationMetrics table, edge;
     cv::Mat labels;
     const size_t frames = std::min<size_t>(scene.scenario.frames.size(), 20);
     for (size_t i = 0; i < frames; ++i) {
@@ -48,16 +36,17 @@ TEST(CarpetEdgeOnTheFamily, HallWhiteAndBlackGoTheLinesAndRobotsStay) {
       trainer.cycle(view, f.told_pose);
       if (i < 10) continue;  // after the start's adaptation
       segmenter.classify(trainer.lut(), view, labels);
-      for (Counts& c : table) c.add(labels, frame.labels);
+      table.add(labels, frame.labels);
       trainer.unlabelBeyondCarpet(labels);
-      for (Counts& c : edge) c.add(labels, frame.labels);
+      edge.add(labels, frame.labels);
     }
     for (size_t j = 0; j < 2; ++j) {
-      std::printf("seed %u: %s recall %.4f -> %.4f, precision %.3f -> %.3f\n", seed, core::className(table[j].k),
-                  table[j].recall(), edge[j].recall(), table[j].precision(), edge[j].precision());
-      EXPECT_GE(edge[j].recall(), table[j].recall() - 0.01) << "seed " << seed;
-      EXPECT_GE(edge[j].precision(), table[j].precision()) << "seed " << seed;
-      precision_gain[j] += edge[j].precision() - table[j].precision();
+      const int k = j == 0 ? core::kWhite : core::kBlack;
+      std::printf("seed %u: %s recall %.4f -> %.4f, precision %.3f -> %.3f\n", seed, core::className(k),
+                  table.recall(k), edge.recall(k), table.precision(k), edge.precision(k));
+      EXPECT_GE(edge.recall(k), table.recall(k) - 0.01) << "seed " << seed;
+      EXPECT_GE(edge.precision(k), table.precision(k)) << "seed " << seed;
+      precision_gain[j] += edge.precision(k) - table.precision(k);
     }
   }
   EXPECT_GT(precision_gain[0] / 6, 0.05);  // white
